@@ -1,0 +1,13 @@
+// The subcommands of terravol. Each add_* registers its options and callback on the app;
+// callbacks throw (FormatError, std::exception) and main() turns that into a one-line
+// message and exit status 1.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace terravol::app {
+
+void add_info_command(CLI::App& app);        // terravol info PATH... [--json]
+void add_sample_dem_command(CLI::App& app);  // terravol sample-dem -o DIR
+
+}  // namespace terravol::app

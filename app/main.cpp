@@ -1,0 +1,30 @@
+// terravol: the command line. Library code throws; only this file decides to exit.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "app/commands.h"
+#include "io/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Terravol: terrain (SRTM, DTED, USGS DEM, ESRI ASCII, GeoTIFF, SPLAT! SDF) and RF "
+      "propagation volumes, drawn through a Multiresolution BSP tree."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "terravol 0.1");
+  terravol::app::add_info_command(app);
+  terravol::app::add_sample_dem_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const terravol::io::FormatError& e) {
+    std::fprintf(stderr, "terravol: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "terravol: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
