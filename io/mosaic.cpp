@@ -1,0 +1,285 @@
+#include "io/mosaic.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <system_error>
+
+#include "io/error.h"
+#include "io/geographic.h"
+#include "io/sdf_name.h"
+#include "io/srtm_write.h"
+
+namespace terravol::io {
+
+namespace {
+
+bool name_has(const std::filesystem::path& p, std::string_view what) {
+  return to_lower(p.filename().string()).find(what) != std::string::npos;
+}
+
+// The last four bytes of a gzip stream: the uncompressed size modulo 2^32 (RFC 1952, 2.3.1).
+std::optional<std::uint32_t> gzip_size(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in || in.tellg() < 18) return std::nullopt;
+  in.seekg(-4, std::ios::end);
+  unsigned char b[4];
+  if (!in.read(reinterpret_cast<char*>(b), 4)) return std::nullopt;
+  return static_cast<std::uint32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
+}
+
+// Extent from the file name (and size) alone, for SRTM and SDF tiles; nullopt when the name
+// does not say enough.
+std::optional<MosaicTile> tile_from_name(const std::filesystem::path& path, Format format) {
+  MosaicTile t;
+  t.path = path;
+  t.format = format;
+  t.extent_from_name = true;
+  const std::string name = path.filename().string();
+  if (format == Format::kSrtm) {
+    const auto corner = srtm_corner_from_name(name);
+    if (!corner) return std::nullopt;
+    std::uintmax_t bytes = 0;
+    std::error_code ec;
+    if (name_has(path, ".gz")) {
+      const auto s = gzip_size(path);
+      if (!s) return std::nullopt;
+      bytes = *s;
+    } else if (name_has(path, ".zip")) {
+      return std::nullopt;
+    } else {
+      bytes = std::filesystem::file_size(path, ec);
+      if (ec) return std::nullopt;
+    }
+    int n = 0;
+    if (bytes == 1201u * 1201u * 2u) n = 1201;
+    if (bytes == 3601u * 3601u * 2u) n = 3601;
+    if (n == 0) return std::nullopt;  // let the reader say what is wrong
+    t.rows = t.cols = n;
+    t.georef = {Crs::kGeographic, 0, true, double(corner->west), corner->south + 1.0, 1.0 / (n - 1), 1.0 / (n - 1)};
+    return t;
+  }
+  if (format == Format::kSdf) {
+    const auto corner = sdf_corner_from_name(name);
+    if (!corner) return std::nullopt;
+    const int n = name_has(path, "-hd") ? 3600 : 1200;
+    t.rows = t.cols = n;
+    t.georef = {Crs::kGeographic, 0, true, double(corner->west), corner->south + (n - 1.0) / n, 1.0 / n, 1.0 / n};
+    return t;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::filesystem::path> expand_inputs(const std::vector<std::filesystem::path>& inputs) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& in : inputs) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(in, ec)) {
+      std::vector<std::filesystem::path> found;
+      for (const auto& entry : std::filesystem::directory_iterator(in, ec)) {
+        if (entry.is_regular_file(ec) && format_from_name(entry.path())) found.push_back(entry.path());
+      }
+      if (ec) throw FormatError(in.string(), "cannot list directory: " + ec.message());
+      if (found.empty()) throw FormatError(in.string(), "directory holds no DEM files");
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (!std::filesystem::exists(in, ec)) {
+      throw FormatError(in.string(), "no such file or directory");
+    } else {
+      files.push_back(in);
+    }
+  }
+  return files;
+}
+
+bool same_spacing(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(a, b); }
+
+std::string fmt_deg(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6f", v);
+  return b;
+}
+
+}  // namespace
+
+Grid read_geographic(const std::filesystem::path& path, const ReadOptions& options) {
+  Grid g = read_dem(path, options);
+  if (g.georef.crs != Crs::kGeographic) g = to_geographic(g, path.string());
+  return g;
+}
+
+Mosaic Mosaic::open(const std::vector<std::filesystem::path>& inputs, const ReadOptions& options,
+                    std::size_t cache_tiles) {
+  Mosaic m;
+  m.options_ = options;
+  m.cache_capacity_ = std::max<std::size_t>(1, cache_tiles);
+  const auto files = expand_inputs(inputs);
+  if (files.empty()) throw FormatError("terravol", "no DEM given");
+
+  for (const auto& path : files) {
+    const auto format = format_from_name(path);
+    if (!format) throw FormatError(path.string(), "unknown DEM format");
+    if (auto t = tile_from_name(path, *format)) {
+      m.tiles_.push_back(*t);
+      continue;
+    }
+    Grid g = read_geographic(path, options);  // read once to learn the extent; kept in the cache
+    MosaicTile t;
+    t.path = path;
+    t.format = *format;
+    t.rows = g.rows;
+    t.cols = g.cols;
+    t.georef = g.georef;
+    m.tiles_.push_back(t);
+    ++m.loads_;
+    m.cache_insert(m.tiles_.size() - 1, std::move(g));
+  }
+
+  // The lattice: the first tile's spacing, origin at the north-west-most sample.
+  const Georef& first = m.tiles_.front().georef;
+  double west = first.x0, north = first.y0;
+  for (const auto& t : m.tiles_) {
+    if (!same_spacing(t.georef.dx, first.dx) || !same_spacing(t.georef.dy, first.dy)) {
+      throw FormatError(t.path.string(), "sample spacing " + fmt_deg(t.georef.dx * 3600) + "\" x " +
+                                             fmt_deg(t.georef.dy * 3600) + "\" differs from " +
+                                             m.tiles_.front().path.filename().string() + "'s " +
+                                             fmt_deg(first.dx * 3600) + "\" x " + fmt_deg(first.dy * 3600) +
+                                             "\"; a mosaic needs one spacing");
+    }
+    west = std::min(west, t.georef.x0);
+    north = std::max(north, t.georef.y0);
+  }
+  m.georef_ = {Crs::kGeographic, 0, true, west, north, first.dx, first.dy};
+  long long rows = 0, cols = 0;
+  for (auto& t : m.tiles_) {
+    const double fc = (t.georef.x0 - west) / first.dx, fr = (north - t.georef.y0) / first.dy;
+    if (std::abs(fc - std::round(fc)) > 0.01 || std::abs(fr - std::round(fr)) > 0.01) {
+      throw FormatError(t.path.string(), "samples are not on the mosaic's lattice (offset by a fraction of a sample)");
+    }
+    t.col0 = static_cast<int>(std::lround(fc));
+    t.row0 = static_cast<int>(std::lround(fr));
+    rows = std::max<long long>(rows, t.row0 + static_cast<long long>(t.rows));
+    cols = std::max<long long>(cols, t.col0 + static_cast<long long>(t.cols));
+  }
+  if (rows > kMaxSide || cols > kMaxSide) {
+    throw FormatError(files.front().string(), "mosaic of " + std::to_string(rows) + " x " + std::to_string(cols) +
+                                                  " samples is too large to address");
+  }
+  m.rows_ = static_cast<int>(rows);
+  m.cols_ = static_cast<int>(cols);
+
+  // Gaps: cut the bounding box at every tile edge; cells no tile covers are gaps.
+  std::vector<int> xs{0, m.cols_}, ys{0, m.rows_};
+  for (const auto& t : m.tiles_) {
+    xs.insert(xs.end(), {t.col0, t.col0 + t.cols});
+    ys.insert(ys.end(), {t.row0, t.row0 + t.rows});
+  }
+  for (auto* v : {&xs, &ys}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
+    for (std::size_t i = 0; i + 1 < xs.size(); ++i) {
+      const bool covered = std::any_of(m.tiles_.begin(), m.tiles_.end(), [&](const MosaicTile& t) {
+        return t.col0 <= xs[i] && xs[i + 1] <= t.col0 + t.cols && t.row0 <= ys[j] && ys[j + 1] <= t.row0 + t.rows;
+      });
+      if (covered) continue;
+      MosaicGap g{ys[j], xs[i], ys[j + 1] - ys[j], xs[i + 1] - xs[i], 0, 0, 0, 0};
+      // Merge with the gap to the left in the same band.
+      if (!m.gaps_.empty() && m.gaps_.back().row0 == g.row0 && m.gaps_.back().rows == g.rows &&
+          m.gaps_.back().col0 + m.gaps_.back().cols == g.col0) {
+        m.gaps_.back().cols += g.cols;
+      } else {
+        m.gaps_.push_back(g);
+      }
+    }
+  }
+  for (auto& g : m.gaps_) {
+    g.west = west + g.col0 * first.dx;
+    g.east = west + (g.col0 + g.cols - 1) * first.dx;
+    g.north = north - g.row0 * first.dy;
+    g.south = north - (g.row0 + g.rows - 1) * first.dy;
+  }
+  return m;
+}
+
+std::size_t Mosaic::gap_samples() const {
+  std::size_t n = 0;
+  for (const auto& g : gaps_) n += static_cast<std::size_t>(g.rows) * static_cast<std::size_t>(g.cols);
+  return n;
+}
+
+const Grid& Mosaic::cache_insert(std::size_t tile, Grid grid) const {
+  while (cache_.size() >= cache_capacity_) cache_.pop_back();
+  cache_.push_front({tile, std::make_unique<Grid>(std::move(grid))});
+  return *cache_.front().grid;
+}
+
+const Grid& Mosaic::tile_grid(std::size_t i) const {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
+    if (it->tile == i) {
+      cache_.splice(cache_.begin(), cache_, it);
+      return *cache_.front().grid;
+    }
+  }
+  const MosaicTile& t = tiles_.at(i);
+  Grid g = read_geographic(t.path, options_);
+  ++loads_;
+  if (g.rows != t.rows || g.cols != t.cols || std::abs(g.georef.x0 - t.georef.x0) > 0.01 * t.georef.dx ||
+      std::abs(g.georef.y0 - t.georef.y0) > 0.01 * t.georef.dy) {
+    throw FormatError(t.path.string(), "content (" + std::to_string(g.rows) + " x " + std::to_string(g.cols) +
+                                           " samples from " + fmt_deg(g.georef.y0) + ", " + fmt_deg(g.georef.x0) +
+                                           ") does not match the extent its name gives");
+  }
+  return cache_insert(i, std::move(g));
+}
+
+Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
+  check_dimensions("mosaic window", n_rows, n_cols, kMaxSamples);
+  Grid out;
+  out.georef = georef_;
+  out.georef.x0 = georef_.x0 + col0 * georef_.dx;
+  out.georef.y0 = georef_.y0 - row0 * georef_.dy;
+  out.allocate(n_rows, n_cols);
+  std::fill(out.mask.begin(), out.mask.end(), Sample::kOutside);
+  for (std::size_t i = 0; i < tiles_.size(); ++i) {
+    const MosaicTile& t = tiles_[i];
+    const int r_begin = std::max(row0, t.row0), r_end = std::min(row0 + n_rows, t.row0 + t.rows);
+    const int c_begin = std::max(col0, t.col0), c_end = std::min(col0 + n_cols, t.col0 + t.cols);
+    if (r_begin >= r_end || c_begin >= c_end) continue;
+    // Skip the tile when earlier tiles already provided every sample it would give.
+    bool needed = false;
+    for (int r = r_begin; r < r_end && !needed; ++r) {
+      const std::size_t base = out.index(r - row0, 0);
+      for (int c = c_begin; c < c_end; ++c) {
+        if (out.mask[base + static_cast<std::size_t>(c - col0)] == Sample::kOutside) {
+          needed = true;
+          break;
+        }
+      }
+    }
+    if (!needed) continue;
+    const Grid& g = tile_grid(i);
+    if (out.format.empty()) {
+      out.format = g.format;
+      out.vertical_datum = g.vertical_datum;
+    } else {
+      if (out.format != g.format) out.format = "mixed";
+      if (out.vertical_datum != g.vertical_datum) out.vertical_datum = "mixed";
+    }
+    out.checksum_errors += g.checksum_errors;
+    for (int r = r_begin; r < r_end; ++r) {
+      for (int c = c_begin; c < c_end; ++c) {
+        const std::size_t o = out.index(r - row0, c - col0);
+        if (out.mask[o] != Sample::kOutside) continue;  // a shared edge already read
+        const std::size_t s = g.index(r - t.row0, c - t.col0);
+        out.heights[o] = g.heights[s];
+        out.mask[o] = g.mask[s];
+      }
+    }
+  }
+  if (out.format.empty()) out.format = "none";
+  return out;
+}
+
+}  // namespace terravol::io

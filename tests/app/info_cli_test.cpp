@@ -1,0 +1,143 @@
+// `terravol info` as a user runs it: real files, the bundled DEM, and bad input.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "run_command.h"
+#include "shared_data.h"
+
+namespace terravol {
+namespace {
+
+using test::run_terravol;
+
+nlohmann::json info_json(const std::string& path) {
+  const auto r = run_terravol("info --json " + path);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return nlohmann::json::parse(r.out);
+}
+
+TEST(InfoCli, HelpListsTheSubcommands) {
+  const auto r = run_terravol("--help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("info"), std::string::npos);
+  EXPECT_NE(r.out.find("sample-dem"), std::string::npos);
+  EXPECT_EQ(run_terravol("info --help").status, 0);
+}
+
+TEST(InfoCli, BundledDemIsDescribedInTextAndJson) {
+  const std::string dem = std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt";
+  const auto r = run_terravol("info " + dem);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("45.000000 N .. 46.000000 N, 6.000000 E .. 7.000000 E"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("36 (36 samples filled for rendering)"), std::string::npos) << r.out;
+  const auto j = info_json(dem);
+  for (const char* key : {"format", "rows", "cols", "south", "north", "west", "east", "min_elevation",
+                          "max_elevation", "voids", "tiles"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["rows"], 1201);
+  EXPECT_EQ(j["voids"], 36);
+}
+
+TEST(InfoCli, SampleDemIsRegeneratedByteForByte) {
+  test::TempDir dir;
+  const auto r = run_terravol("sample-dem -o " + dir.path().string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(slurp(dir.path() / "N45E006.hgt"), slurp(std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"));
+  const auto again = run_terravol("sample-dem -o " + dir.path().string());
+  EXPECT_EQ(again.status, 1) << "an existing file is not overwritten without --force";
+}
+
+// The table of ../shared/data/README.md: grid, bounds and elevation range of each file.
+struct Expected {
+  const char* file;
+  int rows, cols;
+  double south, north, west, east, min_h, max_h;
+  double bounds_tolerance;
+};
+
+class InfoOnSharedData : public ::testing::TestWithParam<Expected> {};
+
+TEST_P(InfoOnSharedData, ReportsTheGridBoundsAndElevationRangeOfTheDataTable) {
+  const Expected e = GetParam();
+  const auto path = test::shared_dem(e.file);
+  TERRAVOL_REQUIRE_SHARED(path);
+  const auto j = info_json(path.string());
+  const auto& t = j["tiles"][0];
+  EXPECT_EQ(t["rows"], e.rows);
+  EXPECT_EQ(t["cols"], e.cols);
+  EXPECT_NEAR(t["south"].get<double>(), e.south, e.bounds_tolerance);
+  EXPECT_NEAR(t["north"].get<double>(), e.north, e.bounds_tolerance);
+  EXPECT_NEAR(t["west"].get<double>(), e.west, e.bounds_tolerance);
+  EXPECT_NEAR(t["east"].get<double>(), e.east, e.bounds_tolerance);
+  EXPECT_EQ(t["min_elevation"].get<double>(), e.min_h);
+  EXPECT_EQ(t["max_elevation"].get<double>(), e.max_h);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    DataTable, InfoOnSharedData,
+    ::testing::Values(Expected{"N44W072.hgt", 1201, 1201, 44, 45, -72, -71, 115, 1908, 1e-9},
+                      Expected{"N22W160.hgt", 1201, 1201, 22, 23, -160, -159, -34, 1579, 1e-9},
+                      Expected{"S46W066.hgt.gz", 3601, 3601, -46, -45, -66, -65, -3, 146, 1e-9},
+                      Expected{"n33_w116_3arc_v2.dt1", 1201, 1201, 33, 34, -116, -115, -87, 1619, 1e-9},
+                      Expected{"front_range_srtmgl3.asc", 758, 758, 39.835, 40.466, -105.816, -105.185, 1547, 4320, 0.002}),
+    [](const auto& param_info) {
+      std::string name = param_info.param.file;
+      for (char& c : name)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      return name;
+    });
+
+TEST(InfoCli, UtahSdfDirectoryIsOneMosaic) {
+  const auto dir = test::shared_dem("utah_sdf");
+  TERRAVOL_REQUIRE_SHARED(dir);
+  const auto j = info_json(dir.string());
+  EXPECT_EQ(j["tiles"].size(), 6u);
+  EXPECT_EQ(j["rows"], 2400);
+  EXPECT_EQ(j["cols"], 3600);
+  EXPECT_NEAR(j["south"].get<double>(), 40.0, 1e-9);
+  EXPECT_NEAR(j["west"].get<double>(), -113.0, 1e-9);
+  EXPECT_NEAR(j["north"].get<double>(), 42.0, 1.0 / 1200 + 1e-9);
+  EXPECT_NEAR(j["east"].get<double>(), -110.0, 1.0 / 1200 + 1e-9);
+  EXPECT_EQ(j["min_elevation"], 1242);
+  EXPECT_EQ(j["max_elevation"], 4111);
+  EXPECT_EQ(j["gap_samples"], 0);
+}
+
+// Bad input: one line "terravol: FILE: what is wrong", exit status 1 or 2, within a second.
+void expect_clean_failure(const std::string& args, const std::string& must_mention) {
+  const auto r = run_terravol(args);
+  EXPECT_TRUE(r.status == 1 || r.status == 2) << args << " exited " << r.status << "\n" << r.err;
+  EXPECT_LT(r.seconds, 1.0) << args;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(must_mention), std::string::npos) << r.err;
+}
+
+TEST(InfoCli, BadInputFailsCleanlyWithOneLine) {
+  test::TempDir dir;
+  const auto p = [&](const char* name) { return (dir.path() / name).string(); };
+  std::ofstream(p("N10E010.hgt"), std::ios::binary) << std::string(1000, '\0');
+  std::ofstream(p("garbage.dt1"), std::ios::binary) << std::string(5000, 'x');
+  std::ofstream(p("huge.asc")) << "ncols 1000000000\nnrows 1000000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n";
+  std::ofstream(p("trunc.asc")) << "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 0.1\n1 2 3\n4 5\n";
+  std::ofstream(p("junk.tif")) << "II*\0garbage";
+  std::ofstream(p("short.hgt.gz")) << "\x1f\x8b\x08\x00";
+  std::ofstream(p("notes.txt")) << "hello";
+  expect_clean_failure("info " + p("N10E010.hgt"), "N10E010.hgt: size 1000 bytes");
+  expect_clean_failure("info " + p("garbage.dt1"), "garbage.dt1: ");
+  expect_clean_failure("info " + p("huge.asc"), "huge.asc: ");
+  expect_clean_failure("info " + p("trunc.asc"), "trunc.asc: ");
+  expect_clean_failure("info " + p("junk.tif"), "junk.tif: ");
+  expect_clean_failure("info " + p("short.hgt.gz"), "short.hgt.gz: ");
+  expect_clean_failure("info " + p("notes.txt"), "notes.txt: unknown DEM format");
+  expect_clean_failure("info " + p("missing.hgt"), "missing.hgt: ");
+  expect_clean_failure("info --crs utm:99X " + p("trunc.asc"), "--crs");
+}
+
+}  // namespace
+}  // namespace terravol

@@ -1,0 +1,149 @@
+#include "io/mosaic.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "io/error.h"
+#include "io/srtm_write.h"
+#include "shared_data.h"
+#include "temp_dir.h"
+
+namespace terravol::io {
+namespace {
+
+// Height of a global function at a lattice point of 3" spacing: integer metres so that
+// it survives the int16 round trip exactly.
+float global_height(double lat, double lon) {
+  return static_cast<float>(std::lround(1000.0 + 400.0 * std::sin(lat * 3.0) + 300.0 * std::cos(lon * 2.0)));
+}
+
+void write_tile(const std::filesystem::path& dir, int south, int west, float edge_offset = 0.0f) {
+  Grid g;
+  g.allocate(1201, 1201);
+  for (int r = 0; r < 1201; ++r)
+    for (int c = 0; c < 1201; ++c) {
+      g.heights[g.index(r, c)] = global_height(south + 1.0 - r / 1200.0, west + c / 1200.0);
+      if (c == 0) g.heights[g.index(r, c)] += edge_offset;
+    }
+  const auto bytes = encode_srtm(g);
+  std::ofstream(dir / (srtm_tile_name(south, west) + ".hgt"), std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(Mosaic, TwoByTwoTilesShareTheirEdgesAndFormOneLattice) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w);
+  const Mosaic m = Mosaic::open({dir.path()});
+  EXPECT_EQ(m.rows(), 2401);
+  EXPECT_EQ(m.cols(), 2401);
+  EXPECT_EQ(m.georef().x0, -72.0);
+  EXPECT_EQ(m.georef().y0, 46.0);
+  EXPECT_TRUE(m.gaps().empty());
+  EXPECT_EQ(m.loads(), 0u) << "SRTM tiles are placed from their names without reading them";
+
+  const Grid w = m.read_window(1100, 1150, 200, 100);  // across all four tiles
+  EXPECT_EQ(m.loads(), 4u);
+  for (int r = 0; r < w.rows; ++r)
+    for (int c = 0; c < w.cols; ++c) {
+      ASSERT_EQ(w.mask[w.index(r, c)], Sample::kValid);
+      ASSERT_EQ(w.heights[w.index(r, c)], global_height(46.0 - (1100 + r) / 1200.0, -72.0 + (1150 + c) / 1200.0));
+    }
+}
+
+TEST(Mosaic, WindowInsideOneTileLoadsOnlyThatTile) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w);
+  const Mosaic m = Mosaic::open({dir.path()}, {}, 1);
+  m.read_window(10, 10, 64, 64);
+  EXPECT_EQ(m.loads(), 1u);
+  m.read_window(20, 30, 64, 64);
+  EXPECT_EQ(m.loads(), 1u) << "second read of the same tile comes from the cache";
+  m.read_window(2000, 2000, 64, 64);
+  EXPECT_EQ(m.loads(), 2u);
+  m.read_window(20, 30, 64, 64);
+  EXPECT_EQ(m.loads(), 3u) << "a one-tile cache evicted the first tile";
+}
+
+TEST(Mosaic, SharedEdgeSamplesComeFromTheFirstTileOnly) {
+  test::TempDir dir;
+  write_tile(dir.path(), 44, -72);
+  write_tile(dir.path(), 44, -71, 7.0f);  // its west edge disagrees with its neighbour's east edge
+  const Mosaic m = Mosaic::open({dir.path() / "N44W072.hgt", dir.path() / "N44W071.hgt"});
+  const Grid w = m.read_window(0, 1199, 1, 3);
+  EXPECT_EQ(w.heights[1], global_height(45.0, -71.0)) << "column 1200 is read from N44W072";
+  EXPECT_EQ(m.cols(), 2401);
+}
+
+TEST(Mosaic, MissingTileIsAGapWithItsBounds) {
+  test::TempDir dir;
+  write_tile(dir.path(), 44, -72);
+  write_tile(dir.path(), 45, -71);
+  const Mosaic m = Mosaic::open({dir.path()});
+  EXPECT_EQ(m.rows(), 2401);
+  ASSERT_FALSE(m.gaps().empty());
+  EXPECT_EQ(m.gap_samples(), 2u * 1200u * 1200u);
+  const Grid w = m.read_window(0, 0, 10, 10);  // north-west: no tile
+  EXPECT_EQ(count(w, Sample::kOutside), 100u);
+  EXPECT_EQ(m.gaps().front().west, -72.0);
+  EXPECT_EQ(m.gaps().front().north, 46.0);
+}
+
+TEST(Mosaic, WindowPastTheEdgeIsOutside) {
+  test::TempDir dir;
+  write_tile(dir.path(), 44, -72);
+  const Mosaic m = Mosaic::open({dir.path()});
+  const Grid w = m.read_window(-5, -5, 10, 10);
+  EXPECT_EQ(count(w, Sample::kOutside), 100u - 25u);
+  EXPECT_EQ(w.georef.x0, -72.0 - 5.0 / 1200.0);
+}
+
+TEST(Mosaic, DifferentSpacingsAreRejected) {
+  const auto a = test::shared_dem("N44W072.hgt"), b = test::shared_dem("S46W066.hgt.gz");
+  TERRAVOL_REQUIRE_SHARED(a);
+  TERRAVOL_REQUIRE_SHARED(b);
+  try {
+    Mosaic::open({a, b});
+    FAIL() << "expected FormatError";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("spacing"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Mosaic, EmptyDirectoryAndMissingPathAreErrors) {
+  test::TempDir dir;
+  EXPECT_THROW(Mosaic::open({dir.path()}), FormatError);
+  EXPECT_THROW(Mosaic::open({dir.path() / "nope.hgt"}), FormatError);
+}
+
+TEST(Mosaic, TileOfTheWrongSizeIsReportedWithItsName) {
+  test::TempDir dir;
+  write_tile(dir.path(), 44, -72);
+  std::ofstream(dir.path() / "N44W071.hgt", std::ios::binary) << "short";
+  try {
+    Mosaic::open({dir.path()});
+    FAIL() << "expected FormatError";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("N44W071.hgt: size 5 bytes"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Mosaic, UtahSdfDirectoryIsOneMosaicOfSixTiles) {
+  const auto dir = test::shared_dem("utah_sdf");
+  TERRAVOL_REQUIRE_SHARED(dir);
+  const Mosaic m = Mosaic::open({dir});
+  EXPECT_EQ(m.tiles().size(), 6u);
+  EXPECT_EQ(m.rows(), 2400);
+  EXPECT_EQ(m.cols(), 3600);
+  EXPECT_TRUE(m.gaps().empty());
+  EXPECT_NEAR(m.georef().x0, -113.0, 1e-9);
+  EXPECT_EQ(m.loads(), 0u);
+  const Grid w = m.read_window(1150, 1150, 100, 100);  // the corner where four tiles meet
+  EXPECT_EQ(count(w, Sample::kValid), 10000u);
+}
+
+}  // namespace
+}  // namespace terravol::io

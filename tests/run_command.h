@@ -1,0 +1,43 @@
+// Running the terravol executable from tests: exit status, output and wall time.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "temp_dir.h"
+
+namespace terravol::test {
+
+struct CommandResult {
+  int status = -1;  // exit status; 128 + signal when killed; 124 when it timed out
+  std::string out, err;
+  double seconds = 0.0;
+};
+
+// Runs `terravol ARGS` through the shell with a 30 s limit (coreutils timeout).
+inline CommandResult run_terravol(const std::string& args) {
+  static TempDir dir;
+  const auto out = dir.path() / "stdout", err = dir.path() / "stderr";
+  const std::string cmd = "timeout 30 " + std::string(TERRAVOL_EXE) + " " + args + " >" + out.string() + " 2>" +
+                          err.string() + " </dev/null";
+  const auto t0 = std::chrono::steady_clock::now();
+  const int raw = std::system(cmd.c_str());
+  CommandResult r;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+}  // namespace terravol::test
