@@ -32,10 +32,6 @@ std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path, const st
   return bytes;
 }
 
-std::string_view as_text(const std::vector<std::uint8_t>& bytes) {
-  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
-}
-
 std::string read_text_if_exists(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return {};
@@ -57,36 +53,50 @@ std::optional<Format> format_from_name(const std::filesystem::path& path) {
   return std::nullopt;
 }
 
+std::vector<std::uint8_t> read_content(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::vector<std::uint8_t> bytes = read_bytes(path, source);
+  const std::string name = to_lower(path.filename().string());
+  if (ends_with(name, ".gz")) return gunzip(bytes, source);
+  if (ends_with(name, ".bz2")) return bunzip2(bytes, source);
+  if (ends_with(name, ".zip")) return unzip_entry(bytes, source, ".hgt");
+  return bytes;
+}
+
+Grid parse_dem(Format format, Bytes content, const std::string& source, std::string_view file_name,
+               const ReadOptions& options, std::string_view prj_text) {
+  const std::string_view text(reinterpret_cast<const char*>(content.data()), content.size());
+  switch (format) {
+    case Format::kSrtm:
+      return parse_srtm(content, source, file_name);
+    case Format::kDted:
+      return parse_dted(content, source);
+    case Format::kUsgsDem:
+      return parse_usgs_dem(content, source);
+    case Format::kEsriAscii:
+      return parse_esri_ascii(text, source, options.utm, prj_text);
+    case Format::kGeoTiff:
+      return parse_geotiff(content, source);
+    case Format::kSdf:
+      return parse_sdf(text, source);
+  }
+  throw FormatError(source, "unknown DEM format");
+}
+
 Grid read_dem(const std::filesystem::path& path, const ReadOptions& options) {
   const std::string source = path.string();
   const auto format = format_from_name(path);
   if (!format) {
     throw FormatError(source, "unknown DEM format (expected .hgt[.gz|.zip], .dt0/1/2, .dem, .asc, .tif, .sdf[.bz2])");
   }
-  std::vector<std::uint8_t> bytes = read_bytes(path, source);
-  const std::string name = to_lower(path.filename().string());
-  if (ends_with(name, ".gz")) bytes = gunzip(bytes, source);
-  if (ends_with(name, ".bz2")) bytes = bunzip2(bytes, source);
-  if (ends_with(name, ".zip")) bytes = unzip_entry(bytes, source, ".hgt");
-
-  switch (*format) {
-    case Format::kSrtm:
-      return parse_srtm(bytes, source, path.filename().string());
-    case Format::kDted:
-      return parse_dted(bytes, source);
-    case Format::kUsgsDem:
-      return parse_usgs_dem(bytes, source);
-    case Format::kEsriAscii: {
-      std::filesystem::path prj = path;
-      prj.replace_extension(".prj");
-      return parse_esri_ascii(as_text(bytes), source, options.utm, read_text_if_exists(prj));
-    }
-    case Format::kGeoTiff:
-      return parse_geotiff(bytes, source);
-    case Format::kSdf:
-      return parse_sdf(as_text(bytes), source);
+  const std::vector<std::uint8_t> content = read_content(path);
+  std::string prj;
+  if (*format == Format::kEsriAscii) {
+    std::filesystem::path prj_path = path;
+    prj_path.replace_extension(".prj");
+    prj = read_text_if_exists(prj_path);
   }
-  throw FormatError(source, "unknown DEM format");
+  return parse_dem(*format, content, source, path.filename().string(), options, prj);
 }
 
 }  // namespace terravol::io

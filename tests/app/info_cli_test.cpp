@@ -61,6 +61,8 @@ struct Expected {
   double bounds_tolerance;
 };
 
+void PrintTo(const Expected& e, std::ostream* os) { *os << e.file; }
+
 class InfoOnSharedData : public ::testing::TestWithParam<Expected> {};
 
 TEST_P(InfoOnSharedData, ReportsTheGridBoundsAndElevationRangeOfTheDataTable) {

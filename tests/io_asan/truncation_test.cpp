@@ -1,0 +1,92 @@
+// Hostile input under AddressSanitizer and UBSan (this executable links terravol_io_asan):
+// every reader's real file cut at every length within its headers and at spread lengths past
+// them, and with trailing bytes, must parse or throw FormatError with a one-line message;
+// never crash, read out of bounds, hang or throw anything else.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "io/dem_file.h"
+#include "io/error.h"
+#include "shared_data.h"
+
+namespace terravol::io {
+namespace {
+
+struct Case {
+  const char* file;
+  std::size_t every_length_up_to;  // covers the headers and the first records
+  std::size_t spread_lengths;      // further lengths, evenly spread over the rest
+};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.file; }
+
+// Parses content[0, n) and checks the outcome: a consistent grid or a one-line FormatError.
+void expect_parse_or_clean_error(Format format, const std::vector<std::uint8_t>& content, std::size_t n,
+                                 const std::string& name) {
+  const std::vector<std::uint8_t> cut(content.begin(), content.begin() + static_cast<std::ptrdiff_t>(n));
+  try {
+    const Grid g = parse_dem(format, cut, "cut", name);
+    ASSERT_EQ(g.heights.size(), g.size()) << "length " << n;
+    ASSERT_EQ(g.mask.size(), g.size()) << "length " << n;
+    ASSERT_GT(g.rows, 0);
+    ASSERT_GT(g.cols, 0);
+  } catch (const FormatError& e) {
+    const std::string what = e.what();
+    ASSERT_EQ(what.rfind("cut: ", 0), 0u) << "length " << n << ": " << what;
+    ASSERT_EQ(what.find('\n'), std::string::npos) << "length " << n << ": " << what;
+  }
+}
+
+class Truncation : public ::testing::TestWithParam<Case> {};
+
+TEST_P(Truncation, EveryCutParsesOrFailsWithOneLine) {
+  const Case c = GetParam();
+  const auto path = test::shared_dem(c.file);
+  TERRAVOL_REQUIRE_SHARED(path);
+  const auto format = format_from_name(path);
+  ASSERT_TRUE(format);
+  const std::vector<std::uint8_t> content = read_content(path);
+  const std::string name = path.filename().string();
+  const std::size_t dense = std::min(c.every_length_up_to, content.size());
+  for (std::size_t n = 0; n <= dense; ++n) expect_parse_or_clean_error(*format, content, n, name);
+  for (std::size_t k = 1; k <= c.spread_lengths; ++k) {
+    const std::size_t n = dense + (content.size() - dense) * k / (c.spread_lengths + 1);
+    expect_parse_or_clean_error(*format, content, n, name);
+  }
+  // The whole file, and the whole file with trailing bytes.
+  expect_parse_or_clean_error(*format, content, content.size(), name);
+  std::vector<std::uint8_t> longer = content;
+  longer.insert(longer.end(), {'7', ' ', '\n', 0xff, 0x00, 0x12});
+  expect_parse_or_clean_error(*format, longer, longer.size(), name);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    RealFiles, Truncation,
+    ::testing::Values(Case{"N44W072.hgt", 4096, 16}, Case{"n33_w116_3arc_v2.dt1", 3428 + 2 * 2414 + 8, 24},
+                      Case{"SainteHelens.dem", 2 * 1024 + 64, 24}, Case{"front_range_srtmgl3.asc", 4096, 16},
+                      Case{"olinda_dem_utm25s.tif", 50000, 0}, Case{"utah_sdf/40_41_111_112.sdf.bz2", 2048, 8}),
+    [](const auto& param_info) {
+      std::string name = param_info.param.file;
+      for (char& ch : name)
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      return name;
+    });
+
+// Absurd header values must be refused before anything large is allocated (ASan would report
+// an allocation over its limit; the readers refuse first).
+TEST(HostileHeaders, AbsurdDimensionsAreRefusedWithoutAllocating) {
+  const std::string asc = "ncols 1000000000\nnrows 1000000000\nxllcorner 0\nyllcorner 0\ncellsize 0.001\n1 2\n";
+  EXPECT_THROW(parse_dem(Format::kEsriAscii, {reinterpret_cast<const std::uint8_t*>(asc.data()), asc.size()}, "x",
+                         "x.asc"),
+               FormatError);
+  const std::string sdf = "112\n40\n111\n41\n1\n2\n";
+  EXPECT_THROW(parse_dem(Format::kSdf, {reinterpret_cast<const std::uint8_t*>(sdf.data()), sdf.size()}, "x",
+                         "x.sdf"),
+               FormatError);
+}
+
+}  // namespace
+}  // namespace terravol::io
