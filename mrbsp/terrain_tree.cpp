@@ -1,0 +1,408 @@
+// Multiresolution BSP tree for terrain height fields.
+//
+// Implements Wiley, Campbell, Szygenda, Fussell, Hudson: "Multiresolution BSP Trees Applied to
+// Terrain, Transparency, and General Objects", Graphics Interface 1997:
+//   - section 4.1: nested LOD grids (each level doubles the samples per side); split planes on
+//     grid lines of the coarsest level still available, alternating longitude and latitude to
+//     keep regions square; where a region is one cell of that level, an alternative list of
+//     two: the cell's two triangles (low) and the same region rebuilt from the next level (high);
+//   - section 4.3: sliding. Nodes refer to lattice line indices, never to data, so moving the
+//     window over the terrain only recomputes plane offsets, positions, boxes and errors
+//     (refresh()); the node structure is built once;
+//   - sections 5, 5.1 and figure 5: the draw order (far child, node polygons, near child) and
+//     the LOD choice from the projected bounding box; a second metric, the screen-space error.
+//
+// Departures from the paper, and why:
+//   - The traversal is an explicit stack over flat node arrays (no recursion, no pointers).
+//   - The paper leaves cracks between neighbours at different levels unaddressed; there is no
+//     depth buffer to hide them here, so they are filled with skirts: vertical quads in the
+//     shared boundary plane, emitted only where the neighbour cell at the same level was not
+//     drawn this frame (its region is drawn coarser or finer). A skirt lies in a split plane,
+//     so it is ordered exactly: before the cell's triangles when the plane faces away from the
+//     eye, after them otherwise. Skirts hang to a per-sample bottom below every level's surface
+//     in the level-0 cells around the sample (every level's polyline along an edge inside a
+//     level-0 cell interpolates samples of that cell), so both sides' skirts together cover
+//     the gap, whichever side is higher.
+//   - Inside a cell the two triangles are ordered by the vertical plane through the cell's
+//     diagonal, which separates them.
+#include "mrbsp/terrain_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+namespace terravol::mrbsp {
+
+namespace {
+
+enum : std::uint8_t { kSplitX = 0, kSplitY = 1, kCell = 2 };
+
+// One node of the flat tree (pre-order: children always follow their parent).
+struct Node {
+  glm::vec3 lo{0.0f}, hi{0.0f};  // bounding box of the region's samples (scene frame)
+  float error = 0.0f;            // cell: largest |low-alternative height - full-res sample| (m)
+  float plane = 0.0f;            // split: offset of the plane x = plane or y = plane
+  std::int32_t child[2] = {-1, -1};  // split: [0] west/south side, [1] east/north side;
+                                     // cell: child[0] = high alternative or -1 at the finest level
+  std::uint32_t cell = 0;        // cell: global cell id (Impl::cell_id)
+  std::int32_t line = 0;         // split: lattice line index of the plane
+  std::uint8_t kind = kSplitX;
+  std::uint8_t level = 0;
+};
+
+struct Plane {
+  glm::dvec3 n;
+  double d;  // inside where dot(n, p) + d >= 0
+};
+
+}  // namespace
+
+struct TerrainTree::Impl {
+  int n = 0;        // cells per side
+  int levels = 0;   // L
+  std::vector<Node> nodes;
+  std::vector<double> xs, ys;
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> level_offset;  // first global cell id of each level
+  std::vector<int> level_cells;             // cells per side at each level
+  std::uint32_t total_cells = 0;
+
+  int cell_size(int level) const { return 1 << (levels - 1 - level); }
+  std::uint32_t cell_id(int level, int ci, int cj) const {
+    return level_offset[level] + static_cast<std::uint32_t>(cj * level_cells[level] + ci);
+  }
+  std::uint32_t vertex(int i, int j) const { return static_cast<std::uint32_t>(j * (n + 1) + i); }
+
+  std::int32_t build_region(int rx, int ry, int w, int h, int level);
+  void refresh(const TerrainWindow& window);
+};
+
+std::int32_t TerrainTree::Impl::build_region(int rx, int ry, int w, int h, int level) {
+  const int s = cell_size(level);
+  const auto index = static_cast<std::int32_t>(nodes.size());
+  nodes.emplace_back();
+  if (w == s && h == s) {
+    nodes[index].kind = kCell;
+    nodes[index].level = static_cast<std::uint8_t>(level);
+    nodes[index].cell = cell_id(level, rx / s, ry / s);
+    if (level + 1 < levels) {
+      const std::int32_t high = build_region(rx, ry, s, s, level + 1);
+      nodes[index].child[0] = high;
+    }
+    return index;
+  }
+  // Split at the middle grid line of this level, the longer side first (x when square).
+  const bool split_x = w >= h;
+  const int line = split_x ? rx + w / 2 : ry + h / 2;
+  nodes[index].kind = split_x ? kSplitX : kSplitY;
+  nodes[index].line = line;
+  const std::int32_t a = split_x ? build_region(rx, ry, w / 2, h, level) : build_region(rx, ry, w, h / 2, level);
+  const std::int32_t b = split_x ? build_region(line, ry, w / 2, h, level) : build_region(rx, line, w, h / 2, level);
+  nodes[index].child[0] = a;
+  nodes[index].child[1] = b;
+  return index;
+}
+
+void TerrainTree::Impl::refresh(const TerrainWindow& w) {
+  if (w.cells != n) throw std::invalid_argument("TerrainTree: window has " + std::to_string(w.cells) + " cells, tree has " + std::to_string(n));
+  const std::size_t side = static_cast<std::size_t>(n) + 1;
+  if (w.xs.size() != side || w.ys.size() != side || w.z.size() != side * side) {
+    throw std::invalid_argument("TerrainTree: window arrays do not match its cell count");
+  }
+  for (std::size_t i = 1; i < side; ++i) {
+    if (!(w.xs[i] > w.xs[i - 1]) || !(w.ys[i] > w.ys[i - 1])) {
+      throw std::invalid_argument("TerrainTree: plane offsets must increase strictly");
+    }
+  }
+  xs.assign(w.xs.begin(), w.xs.end());
+  ys.assign(w.ys.begin(), w.ys.end());
+  const auto z = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
+
+  // Skirt bottoms: per sample, the lowest sample of the level-0 cells touching it, minus 1 m.
+  const int s0 = cell_size(0);
+  const int c0 = level_cells[0];
+  std::vector<float> cell0_min(static_cast<std::size_t>(c0) * c0, std::numeric_limits<float>::max());
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const float h = z(i, j);
+      for (int cj = std::max(0, (j - 1) / s0); cj <= std::min(c0 - 1, j / s0); ++cj) {
+        for (int ci = std::max(0, (i - 1) / s0); ci <= std::min(c0 - 1, i / s0); ++ci) {
+          float& m = cell0_min[static_cast<std::size_t>(cj) * c0 + ci];
+          if (i >= ci * s0 && i <= (ci + 1) * s0 && j >= cj * s0 && j <= (cj + 1) * s0) m = std::min(m, h);
+        }
+      }
+    }
+  }
+  positions.resize(2 * side * side);
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      float bottom = std::numeric_limits<float>::max();
+      for (int cj = std::max(0, (j - 1) / s0); cj <= std::min(c0 - 1, j / s0); ++cj)
+        for (int ci = std::max(0, (i - 1) / s0); ci <= std::min(c0 - 1, i / s0); ++ci)
+          if (i >= ci * s0 && i <= (ci + 1) * s0 && j >= cj * s0 && j <= (cj + 1) * s0)
+            bottom = std::min(bottom, cell0_min[static_cast<std::size_t>(cj) * c0 + ci]);
+      const std::size_t v = vertex(i, j);
+      positions[v] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), z(i, j));
+      positions[side * side + v] = glm::vec3(positions[v].x, positions[v].y, bottom - 1.0f);
+    }
+  }
+
+  // Boxes and errors, children before parents (pre-order: reverse index order).
+  for (std::size_t k = nodes.size(); k-- > 0;) {
+    Node& node = nodes[k];
+    if (node.kind != kCell) {
+      node.plane = static_cast<float>(node.kind == kSplitX ? xs[node.line] : ys[node.line]);
+      const Node& a = nodes[node.child[0]];
+      const Node& b = nodes[node.child[1]];
+      node.lo = glm::min(a.lo, b.lo);
+      node.hi = glm::max(a.hi, b.hi);
+      continue;
+    }
+    // Recover the cell's position from its id.
+    const int level = node.level;
+    const int s = cell_size(level);
+    const std::uint32_t local = node.cell - level_offset[level];
+    const int ci = static_cast<int>(local % level_cells[level]), cj = static_cast<int>(local / level_cells[level]);
+    const int i0 = ci * s, j0 = cj * s;
+    const float zsw = z(i0, j0), zse = z(i0 + s, j0), zne = z(i0 + s, j0 + s), znw = z(i0, j0 + s);
+    float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
+    for (int j = 0; j <= s; ++j) {
+      for (int i = 0; i <= s; ++i) {
+        const float h = z(i0 + i, j0 + j);
+        zmin = std::min(zmin, h);
+        zmax = std::max(zmax, h);
+        const float u = static_cast<float>(i) / s, v = static_cast<float>(j) / s;
+        const float approx = u >= v ? zsw + u * (zse - zsw) + v * (zne - zse) : zsw + v * (znw - zsw) + u * (zne - znw);
+        err = std::max(err, std::abs(h - approx));
+      }
+    }
+    node.error = err;
+    node.lo = glm::vec3(static_cast<float>(xs[i0]), static_cast<float>(ys[j0]), zmin);
+    node.hi = glm::vec3(static_cast<float>(xs[i0 + s]), static_cast<float>(ys[j0 + s]), zmax);
+  }
+}
+
+TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::make_unique<Impl>()) {
+  const int n = window.cells;
+  if (n < 2 || (n & (n - 1)) != 0 || n > (1 << 15)) {
+    throw std::invalid_argument("TerrainTree: cells per side must be a power of two in [2, 32768], is " + std::to_string(n));
+  }
+  int k = 0;
+  while ((1 << k) < n) ++k;
+  if (levels < 1 || levels > k + 1) {
+    throw std::invalid_argument("TerrainTree: levels must be in [1, " + std::to_string(k + 1) + "], is " + std::to_string(levels));
+  }
+  Impl& m = *impl_;
+  m.n = n;
+  m.levels = levels;
+  std::uint32_t offset = 0;
+  for (int l = 0; l < levels; ++l) {
+    m.level_offset.push_back(offset);
+    m.level_cells.push_back(n / m.cell_size(l));
+    offset += static_cast<std::uint32_t>(m.level_cells[l]) * static_cast<std::uint32_t>(m.level_cells[l]);
+  }
+  m.total_cells = offset;
+  m.nodes.reserve(static_cast<std::size_t>(offset) * 2);
+  m.build_region(0, 0, n, n, 0);
+  m.refresh(window);
+}
+
+TerrainTree::~TerrainTree() = default;
+TerrainTree::TerrainTree(TerrainTree&&) noexcept = default;
+TerrainTree& TerrainTree::operator=(TerrainTree&&) noexcept = default;
+
+int TerrainTree::cells() const { return impl_->n; }
+int TerrainTree::levels() const { return impl_->levels; }
+const std::vector<glm::vec3>& TerrainTree::positions() const { return impl_->positions; }
+void TerrainTree::slide(const TerrainWindow& window) { impl_->refresh(window); }
+
+namespace {
+
+// The view volume's side and near planes, pointing inwards.
+std::array<Plane, 5> frustum_planes(const Camera& c) {
+  const glm::dvec3 f = glm::normalize(c.forward);
+  const glm::dvec3 r = glm::normalize(glm::cross(f, c.up));
+  const glm::dvec3 u = glm::cross(r, f);
+  const double ty = std::tan(glm::radians(c.fov_y_deg) * 0.5);
+  const double tx = ty * static_cast<double>(c.width) / c.height;
+  const auto through_eye = [&](glm::dvec3 n) {
+    n = glm::normalize(n);
+    return Plane{n, -glm::dot(n, c.eye)};
+  };
+  return {through_eye(glm::cross(u, f + r * tx)),   // right: normal points left-inwards
+          through_eye(glm::cross(f - r * tx, u)),   // left
+          through_eye(glm::cross(f + u * ty, r)),   // top
+          through_eye(glm::cross(r, f - u * ty)),   // bottom
+          Plane{f, -glm::dot(f, c.eye) - c.near_plane}};
+}
+
+bool box_outside(const std::array<Plane, 5>& planes, const glm::vec3& lo, const glm::vec3& hi) {
+  for (const Plane& p : planes) {
+    const glm::dvec3 v(p.n.x >= 0 ? hi.x : lo.x, p.n.y >= 0 ? hi.y : lo.y, p.n.z >= 0 ? hi.z : lo.z);
+    if (glm::dot(p.n, v) + p.d < 0) return true;
+  }
+  return false;
+}
+
+double box_distance(const glm::dvec3& e, const glm::vec3& lo, const glm::vec3& hi) {
+  const glm::dvec3 q = glm::clamp(e, glm::dvec3(lo), glm::dvec3(hi));
+  return glm::length(q - e);
+}
+
+// Projected screen area (pixels) of a box's 2D bounding rectangle, clipped to the viewport;
+// infinite when a corner lies behind the near plane.
+double box_area_px(const Camera& c, const glm::dvec3& f, const glm::dvec3& r, const glm::dvec3& u, double focal_px,
+                   const glm::vec3& lo, const glm::vec3& hi) {
+  double x0 = std::numeric_limits<double>::max(), x1 = -x0, y0 = x0, y1 = -x0;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec3 d = p - c.eye;
+    const double depth = glm::dot(d, f);
+    if (depth <= c.near_plane) return std::numeric_limits<double>::infinity();
+    const double sx = focal_px * glm::dot(d, r) / depth, sy = focal_px * glm::dot(d, u) / depth;
+    x0 = std::min(x0, sx);
+    x1 = std::max(x1, sx);
+    y0 = std::min(y0, sy);
+    y1 = std::max(y1, sy);
+  }
+  const double hw = c.width * 0.5, hh = c.height * 0.5;
+  x0 = std::clamp(x0, -hw, hw);
+  x1 = std::clamp(x1, -hw, hw);
+  y0 = std::clamp(y0, -hh, hh);
+  y1 = std::clamp(y1, -hh, hh);
+  return (x1 - x0) * (y1 - y0);
+}
+
+}  // namespace
+
+void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const {
+  const Impl& m = *impl_;
+  frame.indices.clear();
+  frame.level.clear();
+  frame.nodes_visited = 0;
+  frame.leaves = 0;
+  frame.skirt_triangles = 0;
+  frame.lod_histogram.assign(static_cast<std::size_t>(m.levels), 0);
+  if (frame.stamp_.size() != m.total_cells) {
+    frame.stamp_.assign(m.total_cells, 0);
+    frame.current_stamp_ = 0;
+  }
+  if (++frame.current_stamp_ == 0) {  // wrapped: clear once every 2^32 frames
+    std::fill(frame.stamp_.begin(), frame.stamp_.end(), 0);
+    frame.current_stamp_ = 1;
+  }
+  const std::uint32_t stamp = frame.current_stamp_;
+
+  const glm::dvec3 f = glm::normalize(camera.forward);
+  const glm::dvec3 r = glm::normalize(glm::cross(f, camera.up));
+  const glm::dvec3 u = glm::cross(r, f);
+  const double focal_px = camera.height * 0.5 / std::tan(glm::radians(camera.fov_y_deg) * 0.5);
+  const auto planes = frustum_planes(camera);
+  const glm::dvec3 e = camera.eye;
+  const bool back_to_front = !options.front_to_back;
+
+  // Pass 1: walk the tree, choose LODs, collect the drawn cells in order.
+  auto& stack = frame.stack_;
+  auto& leaves = frame.leaves_;
+  stack.clear();
+  leaves.clear();
+  stack.push_back(0);
+  while (!stack.empty()) {
+    const Node& node = m.nodes[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    ++frame.nodes_visited;
+    if (options.cull && box_outside(planes, node.lo, node.hi)) continue;
+    if (node.kind == kCell) {
+      bool refine = node.child[0] >= 0;
+      if (refine && !options.full_res) {
+        if (options.metric == LodMetric::kError) {
+          const double dist = std::max(box_distance(e, node.lo, node.hi), camera.near_plane);
+          refine = node.error * focal_px / dist > options.threshold_px;
+        } else {
+          refine = box_area_px(camera, f, r, u, focal_px, node.lo, node.hi) > options.threshold_px;
+        }
+      }
+      if (refine) {
+        stack.push_back(node.child[0]);
+      } else {
+        leaves.push_back(node.cell);
+        frame.stamp_[node.cell] = stamp;
+        ++frame.lod_histogram[node.level];
+      }
+      continue;
+    }
+    // The eye's side of the plane: its own side is near. Push the near child first so that
+    // the far child is popped (drawn) first; the reverse for front-to-back.
+    const double eye_coord = node.kind == kSplitX ? e.x : e.y;
+    const bool eye_high = eye_coord >= node.plane;
+    const std::int32_t near_child = node.child[eye_high ? 1 : 0], far_child = node.child[eye_high ? 0 : 1];
+    if (back_to_front) {
+      stack.push_back(near_child);
+      stack.push_back(far_child);
+    } else {
+      stack.push_back(far_child);
+      stack.push_back(near_child);
+    }
+  }
+  frame.leaves = leaves.size();
+
+  // Pass 2: expand each drawn cell into its skirts and triangles, in order.
+  const std::uint32_t bottom = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
+  auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::int8_t level) {
+    frame.indices.insert(frame.indices.end(), {a, b, c});
+    frame.level.push_back(level);
+  };
+  auto emit_skirt = [&](std::uint32_t a, std::uint32_t b) {  // quad under the edge a-b
+    emit(a, bottom + a, bottom + b, -1);
+    emit(a, bottom + b, b, -1);
+    frame.skirt_triangles += 2;
+  };
+  for (const std::uint32_t cell : leaves) {
+    int level = 0;
+    while (level + 1 < m.levels && cell >= m.level_offset[level + 1]) ++level;
+    const int s = m.cell_size(level), cells = m.level_cells[level];
+    const std::uint32_t local = cell - m.level_offset[level];
+    const int ci = static_cast<int>(local % cells), cj = static_cast<int>(local / cells);
+    const int i0 = ci * s, j0 = cj * s, i1 = i0 + s, j1 = j0 + s;
+    const std::uint32_t sw = m.vertex(i0, j0), se = m.vertex(i1, j0), ne = m.vertex(i1, j1), nw = m.vertex(i0, j1);
+
+    // Skirts: only where the same-level neighbour was not drawn this frame.
+    struct Edge {
+      bool needed;
+      bool faces_away;  // the boundary plane lies beyond the cell's content from the eye
+      std::uint32_t a, b;
+    };
+    const Edge edges[4] = {
+        {ci > 0 && frame.stamp_[m.cell_id(level, ci - 1, cj)] != stamp, e.x >= m.xs[i0], nw, sw},          // west
+        {ci + 1 < cells && frame.stamp_[m.cell_id(level, ci + 1, cj)] != stamp, e.x <= m.xs[i1], se, ne},  // east
+        {cj > 0 && frame.stamp_[m.cell_id(level, ci, cj - 1)] != stamp, e.y >= m.ys[j0], sw, se},          // south
+        {cj + 1 < cells && frame.stamp_[m.cell_id(level, ci, cj + 1)] != stamp, e.y <= m.ys[j1], ne, nw},  // north
+    };
+    const bool first_pass_far = back_to_front;
+    for (const Edge& edge : edges)
+      if (edge.needed && edge.faces_away == first_pass_far) emit_skirt(edge.a, edge.b);
+
+    // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
+    const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
+    const bool eye_south_east = side < 0;
+    const auto lvl = static_cast<std::int8_t>(level);
+    if (eye_south_east == back_to_front) {  // draw the north-west triangle first
+      emit(sw, ne, nw, lvl);
+      emit(sw, se, ne, lvl);
+    } else {
+      emit(sw, se, ne, lvl);
+      emit(sw, ne, nw, lvl);
+    }
+    for (const Edge& edge : edges)
+      if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b);
+  }
+}
+
+}  // namespace terravol::mrbsp

@@ -1,0 +1,106 @@
+// The Multiresolution BSP terrain tree (Wiley et al. 1997, sections 4, 4.1, 4.3, 5, 5.1):
+// nested LOD grids of a square terrain window, split planes on meridians and parallels (the
+// scene frame's planes x = c and y = c), one LOD choice per alternative list per frame, and
+// an exact back-to-front (or front-to-back) triangle order with no depth buffer.
+// No VTK and no file I/O here: heights in, index lists out.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace terravol::mrbsp {
+
+// The terrain window, in the scene frame (metres). Samples form an (n+1) x (n+1) lattice,
+// n = 2^k cells per side: column i lies on the plane x = xs[i], row j on y = ys[j] (row 0
+// south, column 0 west), height z[j * (n + 1) + i]. xs and ys must increase strictly.
+struct TerrainWindow {
+  int cells = 0;                 // n, a power of two, >= 2
+  std::span<const double> xs;    // n + 1 plane offsets, west to east
+  std::span<const double> ys;    // n + 1 plane offsets, south to north
+  std::span<const float> z;      // (n + 1)^2 heights, row-major from the south-west
+};
+
+enum class LodMetric : std::uint8_t {
+  kArea,   // the paper's: projected screen area (pixels) of the region's bounding box
+  kError,  // screen-space error (pixels): the low alternative's largest vertical error against
+           // the full-resolution samples it replaces, projected at the box's nearest distance
+};
+
+// A pinhole camera in the scene frame.
+struct Camera {
+  glm::dvec3 eye{0.0};
+  glm::dvec3 forward{0.0, 1.0, 0.0};  // unit view direction
+  glm::dvec3 up{0.0, 0.0, 1.0};       // unit, orthogonal to forward
+  double fov_y_deg = 45.0;            // vertical field of view, (0, 180)
+  int width = 1280, height = 720;     // viewport, pixels
+  double near_plane = 1.0;            // metres, > 0
+};
+
+struct TraversalOptions {
+  LodMetric metric = LodMetric::kError;
+  float threshold_px = 1.0f;    // refine a region while its metric exceeds this
+  bool full_res = false;        // every region at the finest level (the quality reference)
+  bool front_to_back = false;   // reverse order (nearest first)
+  bool cull = true;             // view-frustum culling of regions
+};
+
+// What one traversal produced. Triangles are index triples into TerrainTree::positions(),
+// in draw order. level[t] is the LOD level of triangle t (0 coarsest), or -1 for crack skirts.
+struct Frame {
+  std::vector<std::uint32_t> indices;  // 3 per triangle
+  std::vector<std::int8_t> level;      // 1 per triangle
+  std::size_t nodes_visited = 0;
+  std::size_t leaves = 0;
+  std::size_t skirt_triangles = 0;
+  std::vector<std::size_t> lod_histogram;  // leaves drawn per level
+
+  // Scratch space of the traversal, kept so that a reused Frame does not allocate.
+  std::vector<std::int32_t> stack_;
+  std::vector<std::uint32_t> leaves_;
+  std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
+  std::uint32_t current_stamp_ = 0;
+};
+
+class TerrainTree {
+ public:
+  // Builds the tree of a window with `levels` LOD levels (1 <= levels <= k + 1 for
+  // n = 2^k; level levels-1 is the full-resolution grid, each coarser level halves the
+  // samples per side). Throws std::invalid_argument for a bad window or level count.
+  TerrainTree(const TerrainWindow& window, int levels);
+  ~TerrainTree();
+  TerrainTree(TerrainTree&&) noexcept;
+  TerrainTree& operator=(TerrainTree&&) noexcept;
+
+  int cells() const;
+  int levels() const;
+
+  // Vertex positions: first the (n+1)^2 lattice samples (index j * (n + 1) + i), then one
+  // skirt-bottom vertex per sample (index (n+1)^2 + j * (n + 1) + i) below every surface
+  // the cracks it fills can show. Stable until slide() or update_heights().
+  const std::vector<glm::vec3>& positions() const;
+
+  // Emits the triangles of the view into `frame` (cleared first; its capacity is reused, so
+  // a frame reused across calls does not allocate once warm). Order: for back-to-front,
+  // every triangle is drawn after every triangle it can be hidden by (BSP order: the far
+  // side of each split plane first; inside a cell, the triangle beyond the cell's diagonal
+  // plane first; skirts on boundary planes facing away from the eye before the cell,
+  // facing it after). Cracks between neighbours at different levels are filled with skirts:
+  // vertical quads in the shared boundary plane hanging to the skirt-bottom vertices.
+  void traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const;
+
+  // Sliding (section 4.3): replace the heights and plane offsets for a window moved over the
+  // terrain by whole coarse cells. The node structure is kept; only plane offsets,
+  // positions, bounding boxes and errors are recomputed. Same preconditions as the
+  // constructor, and window.cells must equal cells().
+  void slide(const TerrainWindow& window);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace terravol::mrbsp

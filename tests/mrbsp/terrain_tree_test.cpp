@@ -1,0 +1,270 @@
+#include "mrbsp/terrain_tree.h"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+namespace terravol::mrbsp {
+namespace {
+
+// A window of n x n cells, 100 m spacing, heights from `height(i, j)`.
+struct TestWindow {
+  std::vector<double> xs, ys;
+  std::vector<float> z;
+  int n;
+  template <class F>
+  TestWindow(int cells, F height, double x0 = 0.0, double y0 = 0.0) : n(cells) {
+    for (int i = 0; i <= n; ++i) {
+      xs.push_back(x0 + 100.0 * i);
+      ys.push_back(y0 + 100.0 * i);
+    }
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) z.push_back(height(i, j));
+  }
+  TerrainWindow view() const { return {n, xs, ys, z}; }
+};
+
+Camera looking_down_from(double x, double y, double z) {
+  Camera c;
+  c.eye = {x, y, z};
+  c.forward = {0.0, 0.0, -1.0};
+  c.up = {0.0, 1.0, 0.0};
+  return c;
+}
+
+TEST(TerrainTree, FullResolutionOfAFlatGridIsTwoTrianglesPerCellWithoutSkirts) {
+  const TestWindow w(4, [](int, int) { return 10.0f; });
+  const TerrainTree tree(w.view(), 3);
+  Frame f;
+  TraversalOptions o;
+  o.full_res = true;
+  o.cull = false;
+  tree.traverse(looking_down_from(200, 200, 1000), o, f);
+  EXPECT_EQ(f.indices.size(), 4u * 4u * 2u * 3u);
+  EXPECT_EQ(f.skirt_triangles, 0u);
+  EXPECT_EQ(f.leaves, 16u);
+  EXPECT_EQ(f.lod_histogram, (std::vector<std::size_t>{0, 0, 16}));
+}
+
+TEST(TerrainTree, FlatTerrainNeedsOnlyTheCoarsestLevelUnderTheErrorMetric) {
+  const TestWindow w(8, [](int, int) { return 5.0f; });
+  const TerrainTree tree(w.view(), 3);  // level 0: 2 x 2 cells of 4 fine cells
+  Frame f;
+  TraversalOptions o;
+  o.cull = false;
+  tree.traverse(looking_down_from(400, 400, 50), o, f);
+  EXPECT_EQ(f.leaves, 4u);
+  EXPECT_EQ(f.indices.size(), 4u * 2u * 3u);
+  // Root split, two splits, four cells: seven nodes.
+  EXPECT_EQ(f.nodes_visited, 7u);
+}
+
+TEST(TerrainTree, PositionsHoldTheLatticeThenSkirtBottomsBelowEverySample) {
+  const TestWindow w(4, [](int i, int j) { return static_cast<float>(i * 10 + j); });
+  const TerrainTree tree(w.view(), 2);
+  const auto& p = tree.positions();
+  ASSERT_EQ(p.size(), 2u * 25u);
+  EXPECT_EQ(p[7], glm::vec3(200.0f, 100.0f, 21.0f));
+  for (std::size_t v = 0; v < 25; ++v) {
+    EXPECT_EQ(p[25 + v].x, p[v].x);
+    EXPECT_EQ(p[25 + v].y, p[v].y);
+    EXPECT_LT(p[25 + v].z, p[v].z);
+  }
+}
+
+TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
+  const TestWindow w(16, [](int i, int j) { return static_cast<float>((i * 7 + j * 3) % 11); });
+  const TerrainTree tree(w.view(), 4);
+  Frame f;
+  TraversalOptions o;
+  o.full_res = true;
+  Camera c = looking_down_from(800, 800, 500);
+  c.forward = {0.0, 0.0, 1.0};  // looking at the sky
+  tree.traverse(c, o, f);
+  EXPECT_TRUE(f.indices.empty());
+  c = looking_down_from(800, 800, 500);
+  c.fov_y_deg = 10.0;  // sees about 90 m around (800, 800)
+  tree.traverse(c, o, f);
+  EXPECT_GT(f.leaves, 0u);
+  EXPECT_LT(f.leaves, 16u * 16u / 4u);
+}
+
+TEST(TerrainTree, RejectsBadWindowsAndLevels) {
+  const TestWindow w(8, [](int, int) { return 0.0f; });
+  EXPECT_THROW(TerrainTree(w.view(), 0), std::invalid_argument);
+  EXPECT_THROW(TerrainTree(w.view(), 5), std::invalid_argument);
+  TestWindow bad(6, [](int, int) { return 0.0f; });
+  EXPECT_THROW(TerrainTree(bad.view(), 2), std::invalid_argument);
+  TestWindow descending(8, [](int, int) { return 0.0f; });
+  descending.xs[3] = descending.xs[2];
+  EXPECT_THROW(TerrainTree(descending.view(), 2), std::invalid_argument);
+}
+
+TEST(TerrainTree, SlidingGivesTheSameFramesAsBuildingAnew) {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> h(0.0f, 300.0f);
+  std::vector<float> big(64 * 64);
+  for (float& v : big) v = h(rng);
+  auto window_at = [&](int ox, int oy) {
+    return TestWindow(16, [&](int i, int j) { return big[static_cast<std::size_t>((oy + j) * 64 + ox + i)]; },
+                      100.0 * ox, 100.0 * oy);
+  };
+  const TestWindow a = window_at(0, 0), b = window_at(8, 4);
+  TerrainTree slid(a.view(), 4);
+  slid.slide(b.view());
+  const TerrainTree fresh(b.view(), 4);
+  EXPECT_EQ(slid.positions(), fresh.positions());
+  Frame fs, ff;
+  TraversalOptions o;
+  o.threshold_px = 2.0f;
+  Camera c = looking_down_from(1500, 900, 800);
+  c.forward = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  slid.traverse(c, o, fs);
+  fresh.traverse(c, o, ff);
+  EXPECT_EQ(fs.indices, ff.indices);
+  EXPECT_GT(fs.indices.size(), 0u);
+}
+
+// --- Back-to-front order against brute force -----------------------------------------------
+
+// Distance along the ray to the triangle, or a negative value when it misses (Moller-Trumbore).
+double ray_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
+                    const glm::dvec3& c) {
+  const glm::dvec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+  const double det = glm::dot(e1, p);
+  if (std::abs(det) < 1e-12) return -1.0;
+  const glm::dvec3 s = o - a;
+  const double u = glm::dot(s, p) / det;
+  if (u < 0.0 || u > 1.0) return -1.0;
+  const glm::dvec3 q = glm::cross(s, e1);
+  const double v = glm::dot(d, q) / det;
+  if (v < 0.0 || u + v > 1.0) return -1.0;
+  return glm::dot(e2, q) / det;
+}
+
+// For rays from the eye in many directions: along each ray, hits must be drawn from the
+// farthest to the nearest (back-to-front) or the reverse. Hits at the same distance (shared
+// edges, coplanar skirts) are not ordered against each other. Returns the violations.
+int order_violations(const TerrainTree& tree, const Frame& f, const glm::dvec3& eye, int rays, std::mt19937& rng,
+                     bool back_to_front) {
+  const auto& p = tree.positions();
+  std::normal_distribution<double> g;
+  int violations = 0;
+  std::vector<std::pair<double, std::size_t>> hits;
+  for (int r = 0; r < rays; ++r) {
+    glm::dvec3 d(g(rng), g(rng), g(rng));
+    d = glm::normalize(d);
+    hits.clear();
+    for (std::size_t t = 0; t < f.indices.size() / 3; ++t) {
+      const double dist = ray_triangle(eye, d, p[f.indices[3 * t]], p[f.indices[3 * t + 1]], p[f.indices[3 * t + 2]]);
+      if (dist > 0) hits.emplace_back(dist, t);
+    }
+    std::sort(hits.begin(), hits.end());
+    for (std::size_t a = 0; a < hits.size(); ++a)
+      for (std::size_t b = a + 1; b < hits.size(); ++b) {
+        if (hits[b].first - hits[a].first < 1e-6 * hits[b].first) continue;
+        // hits[a] is nearer: back-to-front draws it later.
+        if (back_to_front ? hits[a].second < hits[b].second : hits[a].second > hits[b].second) ++violations;
+      }
+  }
+  return violations;
+}
+
+TEST(TerrainTree, EmittedOrderIsBackToFrontFromRandomEyes) {
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<float> h(0.0f, 40.0f);
+  std::vector<float> heights(17 * 17);
+  for (std::size_t k = 0; k < heights.size(); ++k)
+    heights[k] = 200.0f + 150.0f * std::sin(0.4f * (k % 17)) * std::cos(0.3f * (k / 17)) + h(rng);
+  const TestWindow w(16, [&](int i, int j) { return heights[static_cast<std::size_t>(j * 17 + i)]; });
+  const TerrainTree tree(w.view(), 4);
+  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(-200.0, 900.0);
+  Frame f;
+  std::size_t skirts = 0, mixed_levels = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+    if (trial % 4 == 0) eye.x = 800.0;  // exactly on the root's split plane
+    if (trial % 4 == 1) eye.y = 400.0;  // on a second-level split plane
+    if (trial % 4 == 2) eye.z = 200.0;  // level with much of the terrain
+    Camera c;
+    c.eye = eye;
+    TraversalOptions o;
+    o.cull = false;
+    o.threshold_px = 2.0f * static_cast<float>(1 << (trial % 7));
+    o.front_to_back = trial % 5 == 4;
+    tree.traverse(c, o, f);
+    skirts += f.skirt_triangles;
+    mixed_levels += std::count_if(f.lod_histogram.begin(), f.lod_histogram.end(), [](std::size_t k) { return k > 0; }) > 1;
+    EXPECT_EQ(order_violations(tree, f, eye, 300, rng, !o.front_to_back), 0) << "trial " << trial << " eye " << eye.x
+                                                                             << "," << eye.y << "," << eye.z;
+  }
+  EXPECT_GT(skirts, 0u) << "the property must be exercised with skirts";
+  EXPECT_GT(mixed_levels, 30u) << "and with neighbours at different levels";
+}
+
+// --- LOD behaviour ---------------------------------------------------------------------------
+
+TEST(TerrainTree, FinerThresholdNeverDrawsFewerLeaves) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> h(0.0f, 200.0f);
+  std::vector<float> heights(33 * 33);
+  for (float& v : heights) v = h(rng);
+  const TestWindow w(32, [&](int i, int j) { return heights[static_cast<std::size_t>(j * 33 + i)]; });
+  const TerrainTree tree(w.view(), 5);
+  Camera c = looking_down_from(1600, -500, 600);
+  c.forward = glm::normalize(glm::dvec3(0, 1, -0.4));
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  for (LodMetric metric : {LodMetric::kError, LodMetric::kArea}) {
+    std::size_t previous = 0;
+    for (float t : {1000.0f, 100.0f, 10.0f, 1.0f, 0.1f}) {
+      Frame f;
+      TraversalOptions o;
+      o.metric = metric;
+      o.threshold_px = metric == LodMetric::kArea ? t * 100.0f : t;
+      tree.traverse(c, o, f);
+      EXPECT_GE(f.leaves, previous);
+      previous = f.leaves;
+    }
+    Frame full;
+    TraversalOptions o;
+    o.full_res = true;
+    tree.traverse(c, o, full);
+    EXPECT_GE(full.leaves, previous);
+  }
+}
+
+TEST(TerrainTree, CloserRegionsAreDrawnFiner) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> h(0.0f, 5.0f);
+  std::vector<float> heights(65 * 65);
+  for (std::size_t k = 0; k < heights.size(); ++k)
+    heights[k] = 100.0f * std::sin(0.2f * (k % 65)) * std::cos(0.15f * (k / 65)) + h(rng);
+  const TestWindow w(64, [&](int i, int j) { return heights[static_cast<std::size_t>(j * 65 + i)]; });
+  const TerrainTree tree(w.view(), 6);
+  Camera c = looking_down_from(3200, -100, 300);
+  c.forward = glm::normalize(glm::dvec3(0, 1, -0.3));
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  Frame f;
+  TraversalOptions o;
+  o.threshold_px = 2.0f;
+  tree.traverse(c, o, f);
+  // The first triangles drawn are the farthest: coarser on average than the last ones.
+  const std::size_t n = f.level.size();
+  double first = 0, last = 0;
+  int nf = 0, nl = 0;
+  for (std::size_t t = 0; t < n / 4; ++t)
+    if (f.level[t] >= 0) first += f.level[t], ++nf;
+  for (std::size_t t = n - n / 4; t < n; ++t)
+    if (f.level[t] >= 0) last += f.level[t], ++nl;
+  ASSERT_GT(nf, 0);
+  ASSERT_GT(nl, 0);
+  EXPECT_LT(first / nf, last / nl);
+}
+
+}  // namespace
+}  // namespace terravol::mrbsp
