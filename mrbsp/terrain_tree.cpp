@@ -125,34 +125,34 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   ys.assign(w.ys.begin(), w.ys.end());
   const auto z = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
-  // Skirt bottoms: per sample, the lowest sample of the level-0 cells touching it, minus 1 m.
+  // Skirt bottoms. Every level's polyline along a lattice line, inside one level-0 edge
+  // segment, interpolates samples of that segment; so a skirt under an edge on row j
+  // reaches low enough at the lowest sample of row j within the level-0 segment(s) holding
+  // the edge, minus 1 m. Two bottoms per sample: one for edges along its row (south and
+  // north skirts), one for edges along its column (west and east skirts).
   const int s0 = cell_size(0);
-  const int c0 = level_cells[0];
-  std::vector<float> cell0_min(static_cast<std::size_t>(c0) * c0, std::numeric_limits<float>::max());
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      const float h = z(i, j);
-      for (int cj = std::max(0, (j - 1) / s0); cj <= std::min(c0 - 1, j / s0); ++cj) {
-        for (int ci = std::max(0, (i - 1) / s0); ci <= std::min(c0 - 1, i / s0); ++ci) {
-          float& m = cell0_min[static_cast<std::size_t>(cj) * c0 + ci];
-          if (i >= ci * s0 && i <= (ci + 1) * s0 && j >= cj * s0 && j <= (cj + 1) * s0) m = std::min(m, h);
-        }
+  const std::size_t count = side * side;
+  positions.resize(3 * count);
+  std::vector<float> segment_min(static_cast<std::size_t>(level_cells[0]));
+  for (int pass = 0; pass < 2; ++pass) {  // 0: along rows, 1: along columns
+    for (int line = 0; line <= n; ++line) {
+      const auto at = [&](int k) { return pass == 0 ? z(k, line) : z(line, k); };
+      for (int seg = 0; seg < level_cells[0]; ++seg) {
+        float mn = at(seg * s0);
+        for (int k = seg * s0 + 1; k <= (seg + 1) * s0; ++k) mn = std::min(mn, at(k));
+        segment_min[static_cast<std::size_t>(seg)] = mn;
+      }
+      for (int k = 0; k <= n; ++k) {
+        float bottom = segment_min[static_cast<std::size_t>(std::min(k / s0, level_cells[0] - 1))];
+        if (k % s0 == 0 && k > 0) bottom = std::min(bottom, segment_min[static_cast<std::size_t>(k / s0 - 1)]);
+        const int i = pass == 0 ? k : line, j = pass == 0 ? line : k;
+        const std::size_t v = vertex(i, j);
+        positions[(1 + pass) * count + v] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), bottom - 1.0f);
       }
     }
   }
-  positions.resize(2 * side * side);
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      float bottom = std::numeric_limits<float>::max();
-      for (int cj = std::max(0, (j - 1) / s0); cj <= std::min(c0 - 1, j / s0); ++cj)
-        for (int ci = std::max(0, (i - 1) / s0); ci <= std::min(c0 - 1, i / s0); ++ci)
-          if (i >= ci * s0 && i <= (ci + 1) * s0 && j >= cj * s0 && j <= (cj + 1) * s0)
-            bottom = std::min(bottom, cell0_min[static_cast<std::size_t>(cj) * c0 + ci]);
-      const std::size_t v = vertex(i, j);
-      positions[v] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), z(i, j));
-      positions[side * side + v] = glm::vec3(positions[v].x, positions[v].y, bottom - 1.0f);
-    }
-  }
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), z(i, j));
 
   // Boxes and errors, children before parents (pre-order: reverse index order).
   for (std::size_t k = nodes.size(); k-- > 0;) {
@@ -354,12 +354,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   frame.leaves = leaves.size();
 
   // Pass 2: expand each drawn cell into its skirts and triangles, in order.
-  const std::uint32_t bottom = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
+  const auto count = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
   auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::int8_t level) {
     frame.indices.insert(frame.indices.end(), {a, b, c});
     frame.level.push_back(level);
   };
-  auto emit_skirt = [&](std::uint32_t a, std::uint32_t b) {  // quad under the edge a-b
+  // A quad under the edge a-b; `bottom` is the offset of the bottoms for its direction.
+  auto emit_skirt = [&](std::uint32_t a, std::uint32_t b, std::uint32_t bottom) {
     emit(a, bottom + a, bottom + b, -1);
     emit(a, bottom + b, b, -1);
     frame.skirt_triangles += 2;
@@ -377,17 +378,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     struct Edge {
       bool needed;
       bool faces_away;  // the boundary plane lies beyond the cell's content from the eye
-      std::uint32_t a, b;
+      std::uint32_t a, b, bottom;
     };
     const Edge edges[4] = {
-        {ci > 0 && frame.stamp_[m.cell_id(level, ci - 1, cj)] != stamp, e.x >= m.xs[i0], nw, sw},          // west
-        {ci + 1 < cells && frame.stamp_[m.cell_id(level, ci + 1, cj)] != stamp, e.x <= m.xs[i1], se, ne},  // east
-        {cj > 0 && frame.stamp_[m.cell_id(level, ci, cj - 1)] != stamp, e.y >= m.ys[j0], sw, se},          // south
-        {cj + 1 < cells && frame.stamp_[m.cell_id(level, ci, cj + 1)] != stamp, e.y <= m.ys[j1], ne, nw},  // north
+        {ci > 0 && frame.stamp_[m.cell_id(level, ci - 1, cj)] != stamp, e.x >= m.xs[i0], nw, sw, 2 * count},          // west
+        {ci + 1 < cells && frame.stamp_[m.cell_id(level, ci + 1, cj)] != stamp, e.x <= m.xs[i1], se, ne, 2 * count},  // east
+        {cj > 0 && frame.stamp_[m.cell_id(level, ci, cj - 1)] != stamp, e.y >= m.ys[j0], sw, se, count},          // south
+        {cj + 1 < cells && frame.stamp_[m.cell_id(level, ci, cj + 1)] != stamp, e.y <= m.ys[j1], ne, nw, count},  // north
     };
     const bool first_pass_far = back_to_front;
     for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away == first_pass_far) emit_skirt(edge.a, edge.b);
+      if (edge.needed && edge.faces_away == first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
 
     // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
     const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
@@ -401,7 +402,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       emit(sw, ne, nw, lvl);
     }
     for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b);
+      if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
   }
 }
 

@@ -78,9 +78,11 @@ class TerrainTree {
   int cells() const;
   int levels() const;
 
-  // Vertex positions: first the (n+1)^2 lattice samples (index j * (n + 1) + i), then one
-  // skirt-bottom vertex per sample (index (n+1)^2 + j * (n + 1) + i) below every surface
-  // the cracks it fills can show. Stable until slide() or update_heights().
+  // Vertex positions, three blocks of (n+1)^2: the lattice samples (index v = j * (n + 1) + i),
+  // then per sample the bottom of skirts under edges along its row ((n+1)^2 + v), then the
+  // bottom of skirts under edges along its column (2 (n+1)^2 + v). A bottom lies 1 m below
+  // the lowest sample of its lattice line within the level-0 cell edges through the sample,
+  // hence below every level's surface along those edges. Stable until slide().
   const std::vector<glm::vec3>& positions() const;
 
   // Emits the triangles of the view into `frame` (cleared first; its capacity is reused, so

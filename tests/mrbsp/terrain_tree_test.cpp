@@ -67,13 +67,19 @@ TEST(TerrainTree, PositionsHoldTheLatticeThenSkirtBottomsBelowEverySample) {
   const TestWindow w(4, [](int i, int j) { return static_cast<float>(i * 10 + j); });
   const TerrainTree tree(w.view(), 2);
   const auto& p = tree.positions();
-  ASSERT_EQ(p.size(), 2u * 25u);
+  ASSERT_EQ(p.size(), 3u * 25u);
   EXPECT_EQ(p[7], glm::vec3(200.0f, 100.0f, 21.0f));
   for (std::size_t v = 0; v < 25; ++v) {
-    EXPECT_EQ(p[25 + v].x, p[v].x);
-    EXPECT_EQ(p[25 + v].y, p[v].y);
-    EXPECT_LT(p[25 + v].z, p[v].z);
+    for (std::size_t block : {25u, 50u}) {
+      EXPECT_EQ(p[block + v].x, p[v].x);
+      EXPECT_EQ(p[block + v].y, p[v].y);
+      EXPECT_LT(p[block + v].z, p[v].z);
+    }
   }
+  // Level 0 has cells of 2 x 2: sample (i=3, j=1) lies in row 1's segment i in [2, 4]
+  // (heights 21, 31, 41) and in column 3's segment j in [0, 2] (heights 30, 31, 32).
+  EXPECT_EQ(p[25 + 8].z, 21.0f - 1.0f);
+  EXPECT_EQ(p[50 + 8].z, 30.0f - 1.0f);
 }
 
 TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
