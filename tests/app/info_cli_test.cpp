@@ -81,13 +81,29 @@ TEST_P(InfoOnSharedData, ReportsTheGridBoundsAndElevationRangeOfTheDataTable) {
   EXPECT_EQ(t["max_elevation"].get<double>(), e.max_h);
 }
 
+TEST(InfoCli, SaintHelensHasThe148885SamplesOfItsProfilesAndSaysItWasResampled) {
+  const auto path = test::shared_dem("SainteHelens.dem");
+  TERRAVOL_REQUIRE_SHARED(path);
+  const auto j = info_json(path.string());
+  const auto& t = j["tiles"][0];
+  EXPECT_EQ(t["valid_samples"], 148885);
+  EXPECT_EQ(t["projection"]["zone"], 10);
+  EXPECT_EQ(t["projection"]["hemisphere"], "N");
+  bool resampled = false;
+  for (const auto& note : t["notes"]) resampled |= note.get<std::string>().find("resampled bilinearly") != std::string::npos;
+  EXPECT_TRUE(resampled);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     DataTable, InfoOnSharedData,
     ::testing::Values(Expected{"N44W072.hgt", 1201, 1201, 44, 45, -72, -71, 115, 1908, 1e-9},
                       Expected{"N22W160.hgt", 1201, 1201, 22, 23, -160, -159, -34, 1579, 1e-9},
                       Expected{"S46W066.hgt.gz", 3601, 3601, -46, -45, -66, -65, -3, 146, 1e-9},
                       Expected{"n33_w116_3arc_v2.dt1", 1201, 1201, 33, 34, -116, -115, -87, 1619, 1e-9},
-                      Expected{"front_range_srtmgl3.asc", 758, 758, 39.835, 40.466, -105.816, -105.185, 1547, 4320, 0.002}),
+                      Expected{"front_range_srtmgl3.asc", 758, 758, 39.835, 40.466, -105.816, -105.185, 1547, 4320, 0.002},
+                      // Projected files: the native grid, and the bounds of their geographic presentation.
+                      Expected{"SainteHelens.dem", 466, 327, 46.1224, 46.2488, -122.2516, -122.1234, 682, 2543, 0.001},
+                      Expected{"olinda_dem_utm25s.tif", 111, 111, -8.0397, -7.9502, -34.9162, -34.8264, -1, 88, 0.001}),
     [](const auto& param_info) {
       std::string name = param_info.param.file;
       for (char& c : name)
