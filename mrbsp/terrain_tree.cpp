@@ -27,6 +27,8 @@
 //     diagonal, which separates them.
 #include "mrbsp/terrain_tree.h"
 
+#include "mrbsp/tree_impl.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -39,50 +41,6 @@
 #include <glm/trigonometric.hpp>
 
 namespace terravol::mrbsp {
-
-namespace {
-
-enum : std::uint8_t { kSplitX = 0, kSplitY = 1, kCell = 2 };
-
-// One node of the flat tree (pre-order: children always follow their parent).
-struct Node {
-  glm::vec3 lo{0.0f}, hi{0.0f};  // bounding box of the region's samples (scene frame)
-  float error = 0.0f;            // cell: largest |low-alternative height - full-res sample| (m)
-  float plane = 0.0f;            // split: offset of the plane x = plane or y = plane
-  std::int32_t child[2] = {-1, -1};  // split: [0] west/south side, [1] east/north side;
-                                     // cell: child[0] = high alternative or -1 at the finest level
-  std::uint32_t cell = 0;        // cell: global cell id (Impl::cell_id)
-  std::int32_t line = 0;         // split: lattice line index of the plane
-  std::uint8_t kind = kSplitX;
-  std::uint8_t level = 0;
-};
-
-struct Plane {
-  glm::dvec3 n;
-  double d;  // inside where dot(n, p) + d >= 0
-};
-
-}  // namespace
-
-struct TerrainTree::Impl {
-  int n = 0;        // cells per side
-  int levels = 0;   // L
-  std::vector<Node> nodes;
-  std::vector<double> xs, ys;
-  std::vector<glm::vec3> positions;
-  std::vector<std::uint32_t> level_offset;  // first global cell id of each level
-  std::vector<int> level_cells;             // cells per side at each level
-  std::uint32_t total_cells = 0;
-
-  int cell_size(int level) const { return 1 << (levels - 1 - level); }
-  std::uint32_t cell_id(int level, int ci, int cj) const {
-    return level_offset[level] + static_cast<std::uint32_t>(cj * level_cells[level] + ci);
-  }
-  std::uint32_t vertex(int i, int j) const { return static_cast<std::uint32_t>(j * (n + 1) + i); }
-
-  std::int32_t build_region(int rx, int ry, int w, int h, int level);
-  void refresh(const TerrainWindow& window);
-};
 
 std::int32_t TerrainTree::Impl::build_region(int rx, int ry, int w, int h, int level) {
   const int s = cell_size(level);
@@ -187,6 +145,7 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
     node.lo = glm::vec3(static_cast<float>(xs[i0]), static_cast<float>(ys[j0]), zmin);
     node.hi = glm::vec3(static_cast<float>(xs[i0 + s]), static_cast<float>(ys[j0 + s]), zmax);
   }
+  merge();  // section 4.3: other objects are merged again into the moved tree
 }
 
 TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::make_unique<Impl>()) {
@@ -224,6 +183,14 @@ const std::vector<glm::vec3>& TerrainTree::positions() const { return impl_->pos
 void TerrainTree::slide(const TerrainWindow& window) { impl_->refresh(window); }
 
 namespace {
+
+struct Plane {
+  glm::dvec3 n;
+  double d;  // inside where dot(n, p) + d >= 0
+};
+
+// Marks a traversal stack entry that emits a node's polygons instead of visiting it.
+constexpr std::int32_t kEmitBit = std::int32_t{1} << 30;
 
 // The view volume's side and near planes, pointing inwards.
 std::array<Plane, 5> frustum_planes(const Camera& c) {
@@ -315,8 +282,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   leaves.clear();
   stack.push_back(0);
   while (!stack.empty()) {
-    const Node& node = m.nodes[static_cast<std::size_t>(stack.back())];
+    const std::int32_t top = stack.back();
     stack.pop_back();
+    if (top & kEmitBit) {  // a split node's coplanar polygons, between its far and near sides
+      leaves.push_back(top);
+      continue;
+    }
+    const Node& node = m.nodes[static_cast<std::size_t>(top)];
     ++frame.nodes_visited;
     if (options.cull && box_outside(planes, node.lo, node.hi)) continue;
     if (node.kind == kCell) {
@@ -332,7 +304,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       if (refine) {
         stack.push_back(node.child[0]);
       } else {
-        leaves.push_back(node.cell);
+        leaves.push_back(static_cast<std::int32_t>(&node - m.nodes.data()));
         frame.stamp_[node.cell] = stamp;
         ++frame.lod_histogram[node.level];
       }
@@ -343,15 +315,12 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const double eye_coord = node.kind == kSplitX ? e.x : e.y;
     const bool eye_high = eye_coord >= node.plane;
     const std::int32_t near_child = node.child[eye_high ? 1 : 0], far_child = node.child[eye_high ? 0 : 1];
-    if (back_to_front) {
-      stack.push_back(near_child);
-      stack.push_back(far_child);
-    } else {
-      stack.push_back(far_child);
-      stack.push_back(near_child);
-    }
+    const std::int32_t first = back_to_front ? far_child : near_child, second = back_to_front ? near_child : far_child;
+    stack.push_back(second);
+    if (node.extra >= 0) stack.push_back(kEmitBit | static_cast<std::int32_t>(&node - m.nodes.data()));  // its coplanar polygons
+    stack.push_back(first);
   }
-  frame.leaves = leaves.size();
+  frame.leaves = static_cast<std::size_t>(std::count_if(leaves.begin(), leaves.end(), [](std::int32_t v) { return !(v & kEmitBit); }));
 
   // Pass 2: expand each drawn cell into its skirts and triangles, in order.
   const auto count = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
@@ -361,13 +330,46 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   };
   // A quad under the edge a-b; `bottom` is the offset of the bottoms for its direction.
   auto emit_skirt = [&](std::uint32_t a, std::uint32_t b, std::uint32_t bottom) {
-    emit(a, bottom + a, bottom + b, -1);
-    emit(a, bottom + b, b, -1);
+    emit(a, bottom + a, bottom + b, kSkirtLevel);
+    emit(a, bottom + b, b, kSkirtLevel);
     frame.skirt_triangles += 2;
   };
-  for (const std::uint32_t cell : leaves) {
-    int level = 0;
-    while (level + 1 < m.levels && cell >= m.level_offset[level + 1]) ++level;
+  auto emit_polygon = [&](const Polygon& p) {  // a convex planar polygon as a fan
+    for (std::uint32_t k = 1; k + 1 < p.count; ++k) {
+      emit(m.poly_vertices[p.first], m.poly_vertices[p.first + k], m.poly_vertices[p.first + k + 1], p.level);
+    }
+  };
+  // A leaf's small BSP: the far side of each plane first.
+  auto emit_leaf_bsp = [&](std::int32_t root) {
+    auto& st = frame.leaf_stack_;
+    st.clear();
+    st.push_back(root);
+    while (!st.empty()) {
+      const std::int32_t top = st.back();
+      st.pop_back();
+      if (top & kEmitBit) {
+        const LeafNode& ln = m.leaf_nodes[static_cast<std::size_t>(top & ~kEmitBit)];
+        for (std::uint32_t k = 0; k < ln.count; ++k) emit_polygon(m.polygons[m.leaf_polys[ln.first + k]]);
+        continue;
+      }
+      const LeafNode& ln = m.leaf_nodes[static_cast<std::size_t>(top)];
+      const bool eye_front = glm::dot(ln.n, e) + ln.d >= 0.0;
+      const std::int32_t far_side = eye_front ? ln.back : ln.front, near_side = eye_front ? ln.front : ln.back;
+      const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
+      if (second >= 0) st.push_back(second);
+      st.push_back(kEmitBit | top);
+      if (first >= 0) st.push_back(first);
+    }
+  };
+  for (const std::int32_t item : leaves) {
+    if (item & kEmitBit) {
+      const Extra& x = m.extras[static_cast<std::size_t>(m.nodes[static_cast<std::size_t>(item & ~kEmitBit)].extra)];
+      for (std::uint32_t k = 0; k < x.count; ++k) emit_polygon(m.polygons[m.node_polys[x.first + k]]);
+      continue;
+    }
+    const Node& node = m.nodes[static_cast<std::size_t>(item)];
+    const std::uint32_t cell = node.cell;
+    const int level = node.level;
     const int s = m.cell_size(level), cells = m.level_cells[level];
     const std::uint32_t local = cell - m.level_offset[level];
     const int ci = static_cast<int>(local % cells), cj = static_cast<int>(local / cells);
@@ -390,6 +392,12 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     for (const Edge& edge : edges)
       if (edge.needed && edge.faces_away == first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
 
+    if (node.extra >= 0 && m.extras[static_cast<std::size_t>(node.extra)].leaf_root >= 0) {
+      emit_leaf_bsp(m.extras[static_cast<std::size_t>(node.extra)].leaf_root);
+      for (const Edge& edge : edges)
+        if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
+      continue;
+    }
     // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
     const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
     const bool eye_south_east = side < 0;

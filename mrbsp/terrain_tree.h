@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 namespace terravol::mrbsp {
 
@@ -48,8 +49,20 @@ struct TraversalOptions {
   bool cull = true;             // view-frustum culling of regions
 };
 
+// Frame::level values other than terrain levels (0 coarsest, levels-1 finest).
+inline constexpr std::int8_t kSkirtLevel = -1;   // a crack skirt
+inline constexpr std::int8_t kMergedLevel = -2;  // a merged polygon (isosurface, slice, ...)
+
+// What merging did (section 4.2).
+struct MergeStats {
+  std::size_t input_triangles = 0;
+  std::size_t stored_polygons = 0;  // after splitting by planes and copying into every LOD alternative
+  std::size_t merged_vertices = 0;  // input vertices plus those made by splitting
+  double merge_ms = 0.0;
+};
+
 // What one traversal produced. Triangles are index triples into TerrainTree::positions(),
-// in draw order. level[t] is the LOD level of triangle t (0 coarsest), or -1 for crack skirts.
+// in draw order. level[t] is the LOD level of triangle t, kSkirtLevel or kMergedLevel.
 struct Frame {
   std::vector<std::uint32_t> indices;  // 3 per triangle
   std::vector<std::int8_t> level;      // 1 per triangle
@@ -60,7 +73,8 @@ struct Frame {
 
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::int32_t> stack_;
-  std::vector<std::uint32_t> leaves_;
+  std::vector<std::int32_t> leaves_;
+  std::vector<std::int32_t> leaf_stack_;
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
 };
@@ -100,8 +114,25 @@ class TerrainTree {
   // constructor, and window.cells must equal cells().
   void slide(const TerrainWindow& window);
 
+  // Merges other polygons into the tree (section 4.2), replacing those merged before: each
+  // triangle (three indices into `vertices`, scene frame, with per-vertex RGBA `colors`,
+  // translucent or opaque) is inserted from the root as in an ordinary BSP: classified
+  // against each split plane in double precision with a tolerance of 1e-9 times the window
+  // size, split where it spans, kept at the node where it lies in the plane (drawn between
+  // the far and the near side), copied clipped into every alternative of an LOD list, and
+  // ordered against the cell's terrain triangles by a small BSP in each leaf (autopartition,
+  // the cell's diagonal plane first). Merged vertices follow the terrain's in positions();
+  // their colours are merged_colors(). slide() merges them again into the moved window.
+  // Throws std::invalid_argument for an index out of range or sizes that disagree.
+  MergeStats merge(std::span<const glm::dvec3> vertices, std::span<const glm::u8vec4> colors,
+                   std::span<const std::uint32_t> triangles);
+  // RGBA of merged vertex k, which is positions()[merged_base() + k].
+  const std::vector<glm::u8vec4>& merged_colors() const;
+  std::uint32_t merged_base() const;
+
+  struct Impl;  // defined in mrbsp/tree_impl.h, private to mrbsp/
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
