@@ -19,10 +19,12 @@
 //     shared boundary plane, emitted only where the neighbour cell at the same level was not
 //     drawn this frame (its region is drawn coarser or finer). A skirt lies in a split plane,
 //     so it is ordered exactly: before the cell's triangles when the plane faces away from the
-//     eye, after them otherwise. Skirts hang to a per-sample bottom below every level's surface
-//     in the level-0 cells around the sample (every level's polyline along an edge inside a
-//     level-0 cell interpolates samples of that cell), so both sides' skirts together cover
-//     the gap, whichever side is higher.
+//     eye, after them otherwise. Skirts hang to a bottom below every level's polyline along
+//     their lattice line within the level-0 cell edge (each such polyline interpolates samples
+//     of that edge), so the two sides' skirts together cover the gap, whichever side is
+//     higher. With the eye above the ground only the skirts facing the eye can show a crack
+//     (a ray reaching a gap under the near cell's edge has crossed the near cell's surface),
+//     so only those are drawn; below the ground only the others; near it, both.
 //   - Inside a cell the two triangles are ordered by the vertical plane through the cell's
 //     diagonal, which separates them.
 #include "mrbsp/terrain_tree.h"
@@ -144,6 +146,17 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
     node.error = err;
     node.lo = glm::vec3(static_cast<float>(xs[i0]), static_cast<float>(ys[j0]), zmin);
     node.hi = glm::vec3(static_cast<float>(xs[i0 + s]), static_cast<float>(ys[j0 + s]), zmax);
+  }
+  // The largest error of any alternative inside each level-0 cell (for the skirt choice).
+  level0_error.assign(static_cast<std::size_t>(level_cells[0]) * static_cast<std::size_t>(level_cells[0]), 0.0f);
+  for (const Node& node : nodes) {
+    if (node.kind != kCell) continue;
+    const int s = cell_size(node.level);
+    const std::uint32_t local = node.cell - level_offset[node.level];
+    const int ci = static_cast<int>(local % static_cast<std::uint32_t>(level_cells[node.level])) * s / s0;
+    const int cj = static_cast<int>(local / static_cast<std::uint32_t>(level_cells[node.level])) * s / s0;
+    float& e0 = level0_error[static_cast<std::size_t>(cj * level_cells[0] + ci)];
+    e0 = std::max(e0, node.error);
   }
   merge();  // section 4.3: other objects are merged again into the moved tree
 }
@@ -322,6 +335,28 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   }
   frame.leaves = static_cast<std::size_t>(std::count_if(leaves.begin(), leaves.end(), [](std::int32_t v) { return !(v & kEmitBit); }));
 
+  // Which skirts can show a crack. With the eye above the ground, a ray reaching a gap under
+  // the near cell's edge has crossed that cell's surface first, so only the skirts of cells
+  // beyond a boundary plane (the plane facing the eye) can show; below the ground, only the
+  // others. Near the ground (within the largest error of the level-0 cell under the eye),
+  // both kinds are drawn.
+  bool draw_facing = true, draw_away = true;
+  {
+    const auto clamp_index = [](const std::vector<double>& v, double x) {
+      const auto it = std::upper_bound(v.begin(), v.end(), x);
+      return static_cast<int>(std::clamp<std::ptrdiff_t>(it - v.begin() - 1, 0, static_cast<std::ptrdiff_t>(v.size()) - 2));
+    };
+    const int i = clamp_index(m.xs, e.x), j = clamp_index(m.ys, e.y);
+    const float ground = std::max({m.positions[m.vertex(i, j)].z, m.positions[m.vertex(i + 1, j)].z,
+                                   m.positions[m.vertex(i, j + 1)].z, m.positions[m.vertex(i + 1, j + 1)].z});
+    const float low = std::min({m.positions[m.vertex(i, j)].z, m.positions[m.vertex(i + 1, j)].z,
+                                m.positions[m.vertex(i, j + 1)].z, m.positions[m.vertex(i + 1, j + 1)].z});
+    const int s0 = m.cell_size(0);
+    const float margin = m.level0_error[static_cast<std::size_t>((j / s0) * m.level_cells[0] + i / s0)];
+    if (e.z > ground + margin) draw_away = false;
+    if (e.z < low - margin) draw_facing = false;
+  }
+
   // Pass 2: expand each drawn cell into its skirts and triangles, in order.
   const auto count = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
   auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::int8_t level) {
@@ -390,12 +425,14 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     };
     const bool first_pass_far = back_to_front;
     for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away == first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
+      if (edge.needed && edge.faces_away == first_pass_far && (edge.faces_away ? draw_away : draw_facing))
+        emit_skirt(edge.a, edge.b, edge.bottom);
 
     if (node.extra >= 0 && m.extras[static_cast<std::size_t>(node.extra)].leaf_root >= 0) {
       emit_leaf_bsp(m.extras[static_cast<std::size_t>(node.extra)].leaf_root);
       for (const Edge& edge : edges)
-        if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
+        if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))
+          emit_skirt(edge.a, edge.b, edge.bottom);
       continue;
     }
     // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
@@ -410,7 +447,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       emit(sw, ne, nw, lvl);
     }
     for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away != first_pass_far) emit_skirt(edge.a, edge.b, edge.bottom);
+      if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))
+        emit_skirt(edge.a, edge.b, edge.bottom);
   }
 }
 

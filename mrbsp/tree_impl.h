@@ -60,6 +60,7 @@ struct TerrainTree::Impl {
   std::vector<std::uint32_t> level_offset;  // first global cell id of each level
   std::vector<int> level_cells;             // cells per side at each level
   std::uint32_t total_cells = 0;
+  std::vector<float> level0_error;  // per level-0 cell: the largest error of any cell inside it
 
   // Merged polygons (merge.cpp). Kept so that slide() can merge them again.
   std::vector<glm::dvec3> merge_input_positions;
