@@ -7,6 +7,7 @@
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "io/readers.h"
+#include "parse_check.h"
 #include "shared_data.h"
 
 namespace terravol::io {
@@ -222,16 +223,7 @@ TEST(EsriAscii, ReadsTheFrontRange) {
 
 TEST(EsriAscii, EveryTruncationFailsCleanlyOrParses) {
   auto check = [](const std::string& text, std::size_t step) {
-    for (std::size_t n = 0; n < text.size(); n += step) {
-      try {
-        const Grid g = parse(text.substr(0, n));
-        EXPECT_EQ(g.heights.size(), g.size());
-      } catch (const FormatError& e) {
-        const std::string what = e.what();
-        EXPECT_EQ(what.rfind("t.asc: ", 0), 0u) << what;
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-      }
-    }
+    test::expect_prefixes_handled([](const std::string& t) { return parse(t); }, text, step, "t.asc");
   };
   check(kSmall, 1);
   const auto path = test::shared_dem("front_range_srtmgl3.asc");

@@ -10,6 +10,7 @@
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "io/readers.h"
+#include "parse_check.h"
 #include "shared_data.h"
 
 namespace terravol::io {
@@ -307,18 +308,8 @@ std::string read_file(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Every prefix either fails with a one-line FormatError naming the file, or parses.
 void expect_truncations_handled(const std::string& text, std::size_t step) {
-  for (std::size_t n = 0; n < text.size(); n += step) {
-    try {
-      const Grid g = parse(text.substr(0, n));
-      EXPECT_EQ(g.heights.size(), g.size());
-    } catch (const FormatError& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.rfind("t.dem: ", 0), 0u) << what;
-      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    }
-  }
+  test::expect_prefixes_handled([](const std::string& t) { return parse(t); }, text, step, "t.dem");
 }
 
 TEST(UsgsDem, EveryTruncationOfSyntheticFilesFailsCleanlyOrParses) {

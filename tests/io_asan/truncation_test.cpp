@@ -10,6 +10,7 @@
 
 #include "io/dem_file.h"
 #include "io/error.h"
+#include "parse_check.h"
 #include "shared_data.h"
 
 namespace terravol::io {
@@ -23,21 +24,12 @@ struct Case {
 
 void PrintTo(const Case& c, std::ostream* os) { *os << c.file; }
 
-// Parses content[0, n) and checks the outcome: a consistent grid or a one-line FormatError.
+// Parses content[0, n) and checks the outcome.
 void expect_parse_or_clean_error(Format format, const std::vector<std::uint8_t>& content, std::size_t n,
                                  const std::string& name) {
   const std::vector<std::uint8_t> cut(content.begin(), content.begin() + static_cast<std::ptrdiff_t>(n));
-  try {
-    const Grid g = parse_dem(format, cut, "cut", name);
-    ASSERT_EQ(g.heights.size(), g.size()) << "length " << n;
-    ASSERT_EQ(g.mask.size(), g.size()) << "length " << n;
-    ASSERT_GT(g.rows, 0);
-    ASSERT_GT(g.cols, 0);
-  } catch (const FormatError& e) {
-    const std::string what = e.what();
-    ASSERT_EQ(what.rfind("cut: ", 0), 0u) << "length " << n << ": " << what;
-    ASSERT_EQ(what.find('\n'), std::string::npos) << "length " << n << ": " << what;
-  }
+  test::expect_grid_or_one_line_error([&] { return parse_dem(format, cut, "cut", name); }, "cut",
+                                      "length " + std::to_string(n));
 }
 
 class Truncation : public ::testing::TestWithParam<Case> {};
