@@ -38,6 +38,9 @@
 #include <stdexcept>
 #include <string>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -114,38 +117,45 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), z(i, j));
 
-  // Boxes and errors, children before parents (pre-order: reverse index order).
+  // Cells: box and error from their samples, independent of each other (TBB).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      Node& node = nodes[k];
+      if (node.kind != kCell) continue;
+      const int level = node.level;
+      const int s = cell_size(level);
+      const std::uint32_t local = node.cell - level_offset[level];
+      const int ci = static_cast<int>(local % static_cast<std::uint32_t>(level_cells[level]));
+      const int cj = static_cast<int>(local / static_cast<std::uint32_t>(level_cells[level]));
+      const int i0 = ci * s, j0 = cj * s;
+      const float zsw = z(i0, j0), zse = z(i0 + s, j0), zne = z(i0 + s, j0 + s), znw = z(i0, j0 + s);
+      float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
+      const float inv = 1.0f / static_cast<float>(s);
+      for (int j = 0; j <= s; ++j) {
+        const float v = static_cast<float>(j) * inv;
+        for (int i = 0; i <= s; ++i) {
+          const float h = z(i0 + i, j0 + j);
+          zmin = std::min(zmin, h);
+          zmax = std::max(zmax, h);
+          const float u = static_cast<float>(i) * inv;
+          const float approx = u >= v ? zsw + u * (zse - zsw) + v * (zne - zse) : zsw + v * (znw - zsw) + u * (zne - znw);
+          err = std::max(err, std::abs(h - approx));
+        }
+      }
+      node.error = err;
+      node.lo = glm::vec3(static_cast<float>(xs[static_cast<std::size_t>(i0)]), static_cast<float>(ys[static_cast<std::size_t>(j0)]), zmin);
+      node.hi = glm::vec3(static_cast<float>(xs[static_cast<std::size_t>(i0 + s)]), static_cast<float>(ys[static_cast<std::size_t>(j0 + s)]), zmax);
+    }
+  });
+  // Split nodes: plane offsets and boxes from their children (pre-order: reverse index order).
   for (std::size_t k = nodes.size(); k-- > 0;) {
     Node& node = nodes[k];
-    if (node.kind != kCell) {
-      node.plane = static_cast<float>(node.kind == kSplitX ? xs[node.line] : ys[node.line]);
-      const Node& a = nodes[node.child[0]];
-      const Node& b = nodes[node.child[1]];
-      node.lo = glm::min(a.lo, b.lo);
-      node.hi = glm::max(a.hi, b.hi);
-      continue;
-    }
-    // Recover the cell's position from its id.
-    const int level = node.level;
-    const int s = cell_size(level);
-    const std::uint32_t local = node.cell - level_offset[level];
-    const int ci = static_cast<int>(local % level_cells[level]), cj = static_cast<int>(local / level_cells[level]);
-    const int i0 = ci * s, j0 = cj * s;
-    const float zsw = z(i0, j0), zse = z(i0 + s, j0), zne = z(i0 + s, j0 + s), znw = z(i0, j0 + s);
-    float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
-    for (int j = 0; j <= s; ++j) {
-      for (int i = 0; i <= s; ++i) {
-        const float h = z(i0 + i, j0 + j);
-        zmin = std::min(zmin, h);
-        zmax = std::max(zmax, h);
-        const float u = static_cast<float>(i) / s, v = static_cast<float>(j) / s;
-        const float approx = u >= v ? zsw + u * (zse - zsw) + v * (zne - zse) : zsw + v * (znw - zsw) + u * (zne - znw);
-        err = std::max(err, std::abs(h - approx));
-      }
-    }
-    node.error = err;
-    node.lo = glm::vec3(static_cast<float>(xs[i0]), static_cast<float>(ys[j0]), zmin);
-    node.hi = glm::vec3(static_cast<float>(xs[i0 + s]), static_cast<float>(ys[j0 + s]), zmax);
+    if (node.kind == kCell) continue;
+    node.plane = static_cast<float>(node.kind == kSplitX ? xs[static_cast<std::size_t>(node.line)] : ys[static_cast<std::size_t>(node.line)]);
+    const Node& a = nodes[static_cast<std::size_t>(node.child[0])];
+    const Node& b = nodes[static_cast<std::size_t>(node.child[1])];
+    node.lo = glm::min(a.lo, b.lo);
+    node.hi = glm::max(a.hi, b.hi);
   }
   // The largest error of any alternative inside each level-0 cell (for the skirt choice).
   level0_error.assign(static_cast<std::size_t>(level_cells[0]) * static_cast<std::size_t>(level_cells[0]), 0.0f);
