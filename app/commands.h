@@ -9,5 +9,6 @@ namespace terravol::app {
 
 void add_info_command(CLI::App& app);        // terravol info PATH... [--json]
 void add_sample_dem_command(CLI::App& app);  // terravol sample-dem -o DIR
+void add_render_command(CLI::App& app);      // terravol render DEM... --camera ... -o PNG
 
 }  // namespace terravol::app

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "terravol 0.1");
   terravol::app::add_info_command(app);
   terravol::app::add_sample_dem_command(app);
+  terravol::app::add_render_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,21 @@
+// PNG output of a render window.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+class vtkRenderWindow;
+
+namespace terravol::app {
+
+// The last frame drawn in `window` (its back buffer, RGB, not re-rendered), encoded as PNG
+// (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.
+std::vector<std::uint8_t> window_png(vtkRenderWindow* window);
+
+// Writes PNG bytes to `path` through a temporary file in the same folder and a rename, so a
+// reader never sees half an image. Throws std::runtime_error ("PATH: exists (use --force to
+// overwrite)") when path exists and !overwrite, and on I/O errors (write_file_atomically).
+void write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& png, bool overwrite);
+
+}  // namespace terravol::app

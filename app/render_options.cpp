@@ -1,0 +1,72 @@
+#include "app/render_options.h"
+
+#include <charconv>
+#include <stdexcept>
+#include <string>
+
+namespace terravol::app {
+
+namespace {
+
+// A whole decimal integer in [lo, hi], or nullopt-like failure through `ok`.
+bool parse_int(std::string_view text, int lo, int hi, int& out) {
+  int v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return false;
+  if (v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+std::string quote(std::string_view option, std::string_view text) {
+  return std::string(option) + " " + std::string(text) + ": ";
+}
+
+}  // namespace
+
+void parse_size(std::string_view text, int& width, int& height) {
+  const std::size_t x = text.find('x');
+  int w = 0, h = 0;
+  if (x == std::string_view::npos || !parse_int(text.substr(0, x), 1, 16384, w) ||
+      !parse_int(text.substr(x + 1), 1, 16384, h)) {
+    throw std::invalid_argument(quote("--size", text) + "expected WIDTHxHEIGHT in pixels, each 1..16384, e.g. 1280x720");
+  }
+  width = w;
+  height = h;
+}
+
+Rgb parse_rgb(std::string_view option, std::string_view text) {
+  Rgb c{};
+  std::size_t start = 0;
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t comma = k < 2 ? text.find(',', start) : text.size();
+    int v = 0;
+    if (comma == std::string_view::npos || !parse_int(text.substr(start, comma - start), 0, 255, v)) {
+      throw std::invalid_argument(quote(option, text) + "expected R,G,B with each 0..255, e.g. 255,0,255");
+    }
+    c[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(v);
+    start = comma + 1;
+  }
+  return c;
+}
+
+mrbsp::LodMetric parse_metric(std::string_view text) {
+  if (text == "error") return mrbsp::LodMetric::kError;
+  if (text == "area") return mrbsp::LodMetric::kArea;
+  throw std::invalid_argument(quote("--lod-metric", text) + "unknown metric (expected error or area)");
+}
+
+DrawOrder parse_order(std::string_view text) {
+  if (text == "bsp") return DrawOrder::kBsp;
+  if (text == "zbuffer") return DrawOrder::kZBuffer;
+  throw std::invalid_argument(quote("--order", text) + "unknown order (expected bsp or zbuffer)");
+}
+
+Tint parse_tint(std::string_view text) {
+  if (text == "atlas") return Tint::kAtlas;
+  if (text == "relative") return Tint::kRelative;
+  if (text == "grey" || text == "gray") return Tint::kGrey;
+  throw std::invalid_argument(quote("--tint", text) + "unknown tint (expected atlas, relative or grey)");
+}
+
+}  // namespace terravol::app

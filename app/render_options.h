@@ -1,0 +1,42 @@
+// The options of `terravol render`, and the parsers of its compound values. The parsers throw
+// std::invalid_argument with a one-line message that names the option and the text.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "app/camera.h"
+#include "app/terrain_colors.h"
+#include "app/terrain_renderer.h"
+#include "mrbsp/terrain_tree.h"
+
+namespace terravol::app {
+
+struct RenderOptions {
+  std::vector<std::filesystem::path> dems;  // files or folders, one mosaic
+  CameraPose pose;
+  bool agl = false;                // pose.alt is above the ground under the camera
+  std::filesystem::path output;    // PNG
+  double fov_y_deg = 45.0;         // vertical, (0, 180)
+  RenderSettings render;           // size, order, wireframe, lod colours, background
+  mrbsp::TraversalOptions traversal;
+  int levels = 0;                  // 0: default_levels(window)
+  int max_window = 1024;           // cells, a power of two >= 2
+  ShadingOptions shading;
+  double haze_km = 60.0;           // RenderSettings::haze_distance, km; 0: none
+  bool force = false;              // replace existing outputs
+  std::filesystem::path stats;     // JSON, optional
+  std::filesystem::path export_vtp;  // optional
+};
+
+// "WxH", each 1..16384.
+void parse_size(std::string_view text, int& width, int& height);
+// "R,G,B", each 0..255.
+Rgb parse_rgb(std::string_view option, std::string_view text);
+mrbsp::LodMetric parse_metric(std::string_view text);  // error | area
+DrawOrder parse_order(std::string_view text);          // bsp | zbuffer
+Tint parse_tint(std::string_view text);                // atlas | relative | grey
+
+}  // namespace terravol::app

@@ -1,0 +1,81 @@
+// Terrain colours: a hypsometric tint with hillshading (the paper's "pseudo sun-angle
+// shading", Wiley et al. 1997, section 6), water at or below 0 m, and the per-level colours
+// of --lod-colors (the paper's figure 4).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace terravol::app {
+
+using Rgba = std::array<std::uint8_t, 4>;
+
+enum class Tint : std::uint8_t {
+  kAtlas,     // absolute: green lowlands, tan and brown hills, grey rock, snow above ~3800 m
+  kRelative,  // the atlas ramp stretched over the window's land heights (small relief shows)
+  kGrey,      // no tint: hillshade only
+};
+
+struct ShadingOptions {
+  double sun_azimuth_deg = 315.0;   // where the light comes from, clockwise from north
+  double sun_elevation_deg = 35.0;  // degrees above the horizon, (0, 90]
+  double ambient = 0.35;            // share of light that ignores the slope, [0, 1]
+  Tint tint = Tint::kAtlas;
+};
+
+// Per-vertex normals, shading and colours: of the (n+1)^2 lattice samples (index
+// j * (n + 1) + i, row 0 south) from shade_terrain, or of every vertex of the tree from
+// vertex_shading.
+struct TerrainShading {
+  std::vector<glm::vec3> normals;  // unit, scene frame
+  std::vector<float> shade;        // hillshade factor, 1 on flat ground, ambient .. 1.3
+  std::vector<Rgba> rgba;          // tint times shade; alpha 255
+  // vertex_shading only: where the vertex's sample lies in a (n+1) x (n+1) texture of the
+  // lattice colours (texel centres; row 0 south), for drawing colours independent of the LOD.
+  std::vector<glm::vec2> tcoords;
+};
+
+// cells: n; xs, ys: plane offsets (metres, increasing); z: (n+1)^2 scene-frame heights (with
+// the curvature drop), used for the normals (central differences inside, one-sided at the
+// edges); heights: (n+1)^2 heights in the DEM's datum, used for the tint and for water
+// (height <= 0 m is water, drawn flat-shaded in a water colour).
+TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<const double> ys,
+                             std::span<const float> z, std::span<const float> heights,
+                             const ShadingOptions& options);
+
+// The attributes of the tree's vertices (TerrainTree::positions()): vertex v below
+// `terrain_vertices` (TerrainTree::merged_base()) is a lattice sample or a skirt bottom hanging
+// under sample v % (n+1)^2, and copies that sample's attributes (so a skirt has the colours of
+// the edge it hangs from); the vertices after it are merged polygons', with `merged_colors`,
+// normal +z, shade 1 and texture coordinates (0, 0). Precondition: lattice from shade_terrain.
+TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
+                              std::span<const glm::u8vec4> merged_colors);
+
+// The tint of a height (metres) with no shading; `lo`, `hi` are the window's land height range
+// (used by Tint::kRelative only).
+Rgba tint_of(float height, Tint tint, float lo, float hi);
+
+// --lod-colors: a distinct colour per LOD level (0 coarsest), cycling after 10 levels; never
+// magenta-like (green channel > 60), so a magenta background shows every crack.
+Rgba lod_color(int level);
+// The colour of crack skirts (Frame::level -1) under --lod-colors: neutral grey.
+inline constexpr Rgba kSkirtColor{150, 150, 150, 255};
+
+// The sky behind the terrain as VTK's linear background gradient (bottom to top of the image):
+// the haze colour kHorizon at the horizon line, deepening toward kZenith with elevation, so
+// that the visible sky is exact at the horizon and at the top of the image. pitch_deg: the
+// view's pitch; fov_y_deg: vertical field of view. Returns {bottom, top}.
+inline constexpr std::array<std::uint8_t, 3> kHorizon{214, 226, 238};
+inline constexpr std::array<std::uint8_t, 3> kZenith{64, 118, 196};
+std::array<std::array<std::uint8_t, 3>, 2> sky_gradient(double pitch_deg, double fov_y_deg);
+
+// Scales the RGB of a colour by `shade`, clamped to 255; alpha kept.
+Rgba shaded(const Rgba& c, float shade);
+
+}  // namespace terravol::app

@@ -1,0 +1,107 @@
+// The VTK side of a terrain render: one vtkPolyData holding every vertex of the tree (positions,
+// normals, RGBA, uploaded once), whose triangle list is replaced by each traversal, drawn
+// either in tree order with no depth test (OrderedPolyDataMapper) or with VTK's ordinary
+// depth-tested mapper (the correctness reference), into an offscreen window.
+#pragma once
+
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "app/terrain_colors.h"
+#include "mrbsp/terrain_tree.h"
+
+class vtkActor;
+class vtkCamera;
+class vtkPolyData;
+class vtkPolyDataMapper;
+class vtkRenderer;
+class vtkRenderWindow;
+
+namespace terravol::app {
+
+enum class DrawOrder : std::uint8_t {
+  kBsp,      // the tree's back-to-front order, depth test off (OrderedPolyDataMapper)
+  kZBuffer,  // the same triangles in the same order, vtkPolyDataMapper with the depth test on
+};
+
+using Rgb = std::array<std::uint8_t, 3>;
+
+struct RenderSettings {
+  int width = 1280, height = 720;  // pixels
+  DrawOrder order = DrawOrder::kBsp;
+  bool wireframe = false;
+  bool lod_colors = false;              // per-triangle colours from Frame::level
+  Rgb background{205, 222, 240};        // uniform, or the bottom of the gradient
+  Rgb background_top{95, 145, 210};     // used when gradient
+  bool gradient = true;                 // a sky gradient, bottom to top
+  // Aerial perspective: colours fade toward haze_color with depth d (metres along the view
+  // axis) by 1 - exp(-d / haze_distance), at most 85%; 0 turns it off. Applied in the fragment
+  // shader, so the vertex colours (and --export-vtp) are unhazed.
+  double haze_distance = 0.0;
+  Rgb haze_color{214, 226, 238};
+};
+
+// The lattice colours as one texture (side x side texels, row 0 south): when given, the
+// terrain's colour at every pixel comes from the full-resolution colours whatever LOD the
+// geometry is drawn at (bilinear, no mipmaps), instead of being interpolated between the
+// vertices of coarse triangles. Not used with lod_colors.
+struct ColorTexture {
+  int side = 0;                // n + 1; 0: no texture, per-vertex colours
+  std::span<const Rgba> rgba;  // side * side
+};
+
+// Throws std::runtime_error (one line, naming $DISPLAY and xvfb-run) when no X display can be
+// opened: VTK 9.1 on Debian renders through GLX even offscreen, and aborts without a display.
+// The connection it opens stays open for the process and serves every TerrainRenderer.
+void require_x_display();
+
+class TerrainRenderer {
+ public:
+  // positions: TerrainTree::positions(); shading: per vertex, the same count (vertex_shading).
+  // Opens an offscreen render window on the process's X connection (require_x_display).
+  // Throws std::invalid_argument when the counts differ or the size is not positive, and
+  // std::runtime_error without an X display.
+  TerrainRenderer(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+                  const RenderSettings& settings, const ColorTexture& texture = {});
+  ~TerrainRenderer();
+  TerrainRenderer(const TerrainRenderer&) = delete;
+  TerrainRenderer& operator=(const TerrainRenderer&) = delete;
+
+  // The view: vtkCamera from the tree's camera, clipping range [near_plane, far_plane].
+  void set_camera(const mrbsp::Camera& camera, double far_plane);
+
+  // Replaces the triangle list with the frame's, in its order (and, with lod_colors, the
+  // per-triangle colours: lod_color(level) times the mean shade of the three vertices).
+  void set_frame(const mrbsp::Frame& frame);
+
+  // Draws one frame and waits for the GPU to finish it; returns wall milliseconds.
+  double render();
+
+  // The last rendered image, encoded as PNG.
+  std::vector<std::uint8_t> png() const;
+
+  // The scene: every point, arrays "normals", "rgba" (point data), the current triangles in draw
+  // order, and with lod_colors the cell array "lod_rgba" and always "level" (cell data).
+  vtkPolyData* scene() { return poly_; }
+  vtkCamera* camera();
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  RenderSettings settings_;
+  std::vector<float> shade_;      // per vertex, for --lod-colors
+  std::vector<Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
+  vtkNew<vtkPolyData> poly_;
+  vtkSmartPointer<vtkPolyDataMapper> mapper_;
+  vtkNew<vtkActor> actor_;
+  vtkNew<vtkRenderer> renderer_;
+  vtkNew<vtkRenderWindow> window_;
+};
+
+}  // namespace terravol::app

@@ -1,0 +1,83 @@
+// The terrain a render draws: a square window of the mosaic's lattice around the camera, its
+// voids filled, placed in a scene frame about the window's centre, and its MRBSP tree.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "io/grid.h"
+#include "io/mosaic.h"
+#include "io/scene_frame.h"
+#include "mrbsp/terrain_tree.h"
+
+namespace terravol::app {
+
+// A window of the mosaic lattice: rows [row0, row0 + cells] and columns [col0, col0 + cells]
+// (cells + 1 samples per side; row 0 north, as in io::Grid).
+struct WindowChoice {
+  int row0 = 0, col0 = 0;
+  int cells = 0;  // a power of two, >= 2
+};
+
+// The window for a camera at the fractional lattice position (row, col): side 2^k cells with
+// k the largest such that 2^k + 1 samples fit in the mosaic (rows x cols) and 2^k <= max_cells,
+// centred on (row, col) as nearly as whole samples allow and moved inward to lie inside the
+// mosaic. Preconditions: max_cells a power of two >= 2. Throws std::invalid_argument when the
+// mosaic is smaller than 3 x 3 samples.
+WindowChoice choose_window(int rows, int cols, double row, double col, int max_cells);
+
+// The default level count for a window of `cells` = 2^k cells: k - 2, so that the coarsest
+// level is 8 x 8 cells; at least 1.
+int default_levels(int cells);
+
+// Geographic extent of a window's samples, degrees.
+struct WindowBounds {
+  double south = 0, north = 0, west = 0, east = 0;
+};
+
+class TerrainScene {
+ public:
+  // Reads the window from the mosaic (read_window), fills its voids and the samples no tile
+  // covers (fill_voids), places it in a SceneFrame about the window's centre sample and builds
+  // the tree with `levels` LOD levels (1 <= levels <= k + 1). Throws io::FormatError from the
+  // mosaic and std::invalid_argument for a bad level count.
+  TerrainScene(const io::Mosaic& mosaic, const WindowChoice& window, int levels);
+
+  const io::SceneFrame& frame() const { return frame_; }
+  const WindowChoice& window() const { return window_; }
+  WindowBounds bounds() const { return bounds_; }
+  int cells() const { return window_.cells; }
+  std::size_t filled_samples() const { return filled_; }
+
+  // The lattice in the tree's convention (mrbsp::TerrainWindow): row 0 SOUTH, column 0 west;
+  // xs[i] = x_of_lon(lon of column i), ys[j] = y_of_lat(lat of row j), heights[j * (n+1) + i]
+  // in metres of the DEM's datum (voids filled), z = height - curvature drop.
+  std::span<const double> xs() const { return xs_; }
+  std::span<const double> ys() const { return ys_; }
+  std::span<const float> heights() const { return heights_; }
+  std::span<const float> z() const { return z_; }
+  float min_z() const { return min_z_; }
+  float max_z() const { return max_z_; }
+
+  const mrbsp::TerrainTree& tree() const { return tree_; }
+  double build_ms() const { return build_ms_; }  // the tree's constructor alone, wall clock
+
+  // Bilinear height (metres, datum) at a geographic point; points outside the window are
+  // clamped to its edge.
+  double ground_height(double lat, double lon) const;
+
+ private:
+  static mrbsp::TerrainTree build(TerrainScene& self, const io::Mosaic& mosaic, int levels);
+  WindowChoice window_;
+  WindowBounds bounds_;
+  double lat_step_ = 0, lon_step_ = 0;  // degrees per row and column
+  io::SceneFrame frame_;
+  std::size_t filled_ = 0;
+  std::vector<double> xs_, ys_;
+  std::vector<float> heights_, z_;
+  float min_z_ = 0, max_z_ = 0;
+  double build_ms_ = 0;
+  mrbsp::TerrainTree tree_;
+};
+
+}  // namespace terravol::app

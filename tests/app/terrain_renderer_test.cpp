@@ -1,0 +1,97 @@
+// app/terrain_renderer.h and app/ordered_mapper.h on a tiny scene of their own: the draw order
+// of the triangle list decides visibility under --order bsp, the depth buffer under zbuffer.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "app/terrain_renderer.h"
+#include "image_compare.h"
+#include "require_display.h"
+
+namespace terravol::app {
+namespace {
+
+// Two unit-ish squares seen from above: a red one at z = 5 (near) and a blue one at z = 0 (far).
+struct TwoSquares {
+  std::vector<glm::vec3> positions;
+  TerrainShading shading;
+  mrbsp::Camera camera;
+};
+
+TwoSquares two_squares(std::uint8_t near_alpha) {
+  TwoSquares s;
+  for (float z : {5.0f, 0.0f})
+    for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}})
+      s.positions.emplace_back(x, y, z);
+  for (int v = 0; v < 8; ++v) {
+    s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
+    s.shading.shade.push_back(1.0f);
+    s.shading.rgba.push_back(v < 4 ? Rgba{255, 0, 0, near_alpha} : Rgba{0, 0, 255, 255});
+  }
+  s.camera.eye = {0.0, 0.0, 20.0};
+  s.camera.forward = {0.0, 0.0, -1.0};
+  s.camera.up = {0.0, 1.0, 0.0};
+  s.camera.fov_y_deg = 30.0;
+  s.camera.width = 64;
+  s.camera.height = 64;
+  s.camera.near_plane = 1.0;
+  return s;
+}
+
+mrbsp::Frame frame_of(std::vector<std::uint32_t> indices) {
+  mrbsp::Frame f;
+  f.indices = std::move(indices);
+  f.level.assign(f.indices.size() / 3, 0);
+  return f;
+}
+
+const std::vector<std::uint32_t> kNearThenFar{0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+const std::vector<std::uint32_t> kFarThenNear{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3};
+
+test::Rgb8 centre_pixel(const TwoSquares& s, DrawOrder order, const std::vector<std::uint32_t>& indices) {
+  RenderSettings settings;
+  settings.width = 64;
+  settings.height = 64;
+  settings.order = order;
+  settings.gradient = false;
+  settings.background = {0, 255, 0};
+  TerrainRenderer renderer(s.positions, s.shading, settings);
+  renderer.set_camera(s.camera, 100.0);
+  renderer.set_frame(frame_of(indices));
+  renderer.render();
+  const test::Image img = test::decode_png(renderer.png());
+  EXPECT_EQ(img.width, 64);
+  return img.width == 64 ? img.at(32, 32) : test::Rgb8{};
+}
+
+TEST(TerrainRenderer, BspOrderDrawsLaterTrianglesOnTopWithoutDepthTest) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(255);
+  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, kNearThenFar), (test::Rgb8{0, 0, 255})) << "the far square, drawn last";
+  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, kFarThenNear), (test::Rgb8{255, 0, 0}));
+}
+
+TEST(TerrainRenderer, ZBufferOrderShowsTheNearestWhateverTheOrder) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(255);
+  EXPECT_EQ(centre_pixel(s, DrawOrder::kZBuffer, kNearThenFar), (test::Rgb8{255, 0, 0}));
+  EXPECT_EQ(centre_pixel(s, DrawOrder::kZBuffer, kFarThenNear), (test::Rgb8{255, 0, 0}));
+}
+
+TEST(TerrainRenderer, BspOrderBlendsTranslucentTrianglesOverWhatIsBehind) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(128);  // the near red square half transparent
+  const test::Rgb8 c = centre_pixel(s, DrawOrder::kBsp, kFarThenNear);
+  EXPECT_NEAR(c[0], 128, 2);
+  EXPECT_EQ(c[1], 0);
+  EXPECT_NEAR(c[2], 127, 2);
+}
+
+TEST(TerrainRenderer, EmptyFrameShowsTheBackground) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(255);
+  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, {}), (test::Rgb8{0, 255, 0}));
+}
+
+}  // namespace
+}  // namespace terravol::app
