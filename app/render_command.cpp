@@ -194,7 +194,7 @@ void add_render_command(CLI::App& app) {
   struct Raw {
     RenderOptions o;
     std::string camera, size = "1280x720", metric = "error", order = "bsp", background, tint = "atlas";
-    double threshold = 1.0;
+    double threshold = 0.0;  // when --threshold is not given: the metric's default
   };
   auto raw = std::make_shared<Raw>();
   RenderOptions& o = raw->o;
@@ -208,7 +208,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--size", raw->size, "Image size WIDTHxHEIGHT, pixels")->capture_default_str();
   cmd->add_option("--lod-metric", raw->metric, "LOD metric: error (screen-space error) or area (the paper's)")
       ->capture_default_str();
-  cmd->add_option("--threshold", raw->threshold, "LOD threshold, pixels")->capture_default_str();
+  auto* threshold = cmd->add_option("--threshold", raw->threshold,
+                  "LOD threshold: pixels of screen-space error (default 2) or, with --lod-metric area, "
+                  "projected box area in square pixels (default 500)");
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
   cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
   cmd->add_option("--background", raw->background, "Uniform background R,G,B (0-255) instead of the sky");
@@ -228,7 +230,7 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
       ->capture_default_str();
-  cmd->callback([raw, levels] {
+  cmd->callback([raw, levels, threshold] {
     RenderOptions& opt = raw->o;
     opt.pose = parse_camera_pose(raw->camera);
     parse_size(raw->size, opt.render.width, opt.render.height);
@@ -239,6 +241,7 @@ void add_render_command(CLI::App& app) {
       opt.render.background = parse_rgb("--background", raw->background);
       opt.render.gradient = false;
     }
+    if (threshold->count() == 0) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
     if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
       throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
     }
