@@ -246,6 +246,7 @@ void add_render_command(CLI::App& app) {
       throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
     }
     opt.traversal.threshold_px = static_cast<float>(raw->threshold);
+    opt.traversal.skirts = !opt.render.wireframe;  // skirts patch cracks in filled drawing only
     if (!(opt.fov_y_deg > 0.0 && opt.fov_y_deg < 180.0)) {
       throw std::invalid_argument("--fov " + std::to_string(opt.fov_y_deg) + ": must be within (0, 180) degrees");
     }

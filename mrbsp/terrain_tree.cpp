@@ -350,8 +350,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // beyond a boundary plane (the plane facing the eye) can show; below the ground, only the
   // others. Near the ground (within the largest error of the level-0 cell under the eye),
   // both kinds are drawn.
-  bool draw_facing = true, draw_away = true;
-  {
+  bool draw_facing = options.skirts, draw_away = options.skirts;
+  if (options.skirts) {
     const auto clamp_index = [](const std::vector<double>& v, double x) {
       const auto it = std::upper_bound(v.begin(), v.end(), x);
       return static_cast<int>(std::clamp<std::ptrdiff_t>(it - v.begin() - 1, 0, static_cast<std::ptrdiff_t>(v.size()) - 2));

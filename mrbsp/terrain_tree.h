@@ -53,6 +53,7 @@ struct TraversalOptions {
   bool full_res = false;        // every region at the finest level (the quality reference)
   bool front_to_back = false;   // reverse order (nearest first)
   bool cull = true;             // view-frustum culling of regions
+  bool skirts = true;           // fill cracks (off for wireframe views, where skirts only clutter)
 };
 
 // Frame::level values other than terrain levels (0 coarsest, levels-1 finest).

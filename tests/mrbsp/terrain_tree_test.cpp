@@ -87,6 +87,23 @@ TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
   EXPECT_LT(f.leaves, 16u * 16u / 4u);
 }
 
+TEST(TerrainTree, SkirtsCanBeLeftOut) {
+  const TestWindow w(16, [](int i, int j) { return static_cast<float>((i * 37 + j * 11) % 50); });
+  const TerrainTree tree(w.view(), 4);
+  Camera c = looking_down_from(800, -600, 300);
+  c.forward = glm::normalize(glm::dvec3(0, 1, -0.3));
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  TraversalOptions o;
+  o.threshold_px = 20.0f;
+  Frame with, without;
+  tree.traverse(c, o, with);
+  o.skirts = false;
+  tree.traverse(c, o, without);
+  ASSERT_GT(with.skirt_triangles, 0u);
+  EXPECT_EQ(without.skirt_triangles, 0u);
+  EXPECT_EQ(without.indices.size() / 3, with.indices.size() / 3 - with.skirt_triangles);
+}
+
 TEST(TerrainTree, RejectsBadWindowsAndLevels) {
   const TestWindow w(8, [](int, int) { return 0.0f; });
   EXPECT_THROW(TerrainTree(w.view(), 0), std::invalid_argument);
