@@ -369,9 +369,22 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
 
   // Pass 2: expand each drawn cell into its skirts and triangles, in order.
   const auto count = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
+  // Triangles are written through a cursor into buffers opened to their full capacity (grown
+  // by doubling when a view needs more) and cut to size at the end: no per-triangle
+  // bookkeeping of std::vector, and no allocation once the Frame is warm.
+  std::size_t triangles = 0;
+  frame.indices.resize(std::max<std::size_t>(frame.indices.capacity(), 3 * 1024));
+  frame.level.resize(frame.indices.size() / 3);
   auto emit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::int8_t level) {
-    frame.indices.insert(frame.indices.end(), {a, b, c});
-    frame.level.push_back(level);
+    if (triangles == frame.level.size()) {
+      frame.level.resize(2 * triangles);
+      frame.indices.resize(6 * triangles);
+    }
+    std::uint32_t* out = frame.indices.data() + 3 * triangles;
+    out[0] = a;
+    out[1] = b;
+    out[2] = c;
+    frame.level[triangles++] = level;
   };
   // A quad under the edge a-b; `bottom` is the offset of the bottoms for its direction.
   auto emit_skirt = [&](std::uint32_t a, std::uint32_t b, std::uint32_t bottom) {
@@ -460,6 +473,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))
         emit_skirt(edge.a, edge.b, edge.bottom);
   }
+  frame.indices.resize(3 * triangles);
+  frame.level.resize(triangles);
 }
 
 }  // namespace terravol::mrbsp

@@ -87,6 +87,36 @@ TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
   EXPECT_LT(f.leaves, 16u * 16u / 4u);
 }
 
+// No allocation per frame: once a Frame has seen a view, traversing it again (and nearby views
+// needing no more room) reuses every buffer.
+TEST(TerrainTree, WarmTraversalReusesTheFramesBuffers) {
+  const TestWindow w(32, [](int i, int j) { return static_cast<float>((i * 37 + j * 11) % 80); });
+  const TerrainTree tree(w.view(), 5);
+  Camera c = looking_down_from(1600, -800, 500);
+  c.forward = glm::normalize(glm::dvec3(0, 1, -0.3));
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  Frame f;
+  TraversalOptions o;
+  tree.traverse(c, o, f);
+  f.indices.reserve(f.indices.size() * 2);
+  f.level.reserve(f.level.size() * 2);
+  const auto* indices = f.indices.data();
+  const auto* level = f.level.data();
+  const auto* stack = f.stack_.data();
+  const auto* leaves = f.leaves_.data();
+  const auto* stamp = f.stamp_.data();
+  for (int k = 0; k < 10; ++k) {
+    c.eye.x += 10.0;
+    tree.traverse(c, o, f);
+    ASSERT_GT(f.indices.size(), 0u);
+    EXPECT_EQ(f.indices.data(), indices);
+    EXPECT_EQ(f.level.data(), level);
+    EXPECT_EQ(f.stack_.data(), stack);
+    EXPECT_EQ(f.leaves_.data(), leaves);
+    EXPECT_EQ(f.stamp_.data(), stamp);
+  }
+}
+
 TEST(TerrainTree, SkirtsCanBeLeftOut) {
   const TestWindow w(16, [](int i, int j) { return static_cast<float>((i * 37 + j * 11) % 50); });
   const TerrainTree tree(w.view(), 4);
