@@ -10,5 +10,7 @@ namespace terravol::app {
 void add_info_command(CLI::App& app);        // terravol info PATH... [--json]
 void add_sample_dem_command(CLI::App& app);  // terravol sample-dem -o DIR
 void add_render_command(CLI::App& app);      // terravol render DEM... --camera ... -o PNG
+void add_view_command(CLI::App& app);        // terravol view DEM... (interactive)
+void add_rf_command(CLI::App& app);          // terravol rf --tx ... --dem DEM... -o out.vdb
 
 }  // namespace terravol::app

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   terravol::app::add_info_command(app);
   terravol::app::add_sample_dem_command(app);
   terravol::app::add_render_command(app);
+  terravol::app::add_view_command(app);
+  terravol::app::add_rf_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

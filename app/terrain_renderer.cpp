@@ -106,17 +106,33 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   std::memcpy(rgba->GetPointer(0), shading.rgba.data(), n * sizeof(Rgba));
   poly_->GetPointData()->SetScalars(rgba);
   poly_->SetPolys(vtkNew<vtkCellArray>());
-  const bool textured = texture.side > 0 && !settings.lod_colors;
-  if (textured) {
+  if (texture.side > 0) {
     if (shading.tcoords.size() != n || texture.rgba.size() != static_cast<std::size_t>(texture.side) * texture.side) {
       throw std::invalid_argument("TerrainRenderer: texture coordinates or texture size do not match");
     }
+    texture_side_ = texture.side;
     vtkNew<vtkFloatArray> tcoords;
     tcoords->SetName("tcoords");
     tcoords->SetNumberOfComponents(2);
     tcoords->SetNumberOfTuples(count);
     std::memcpy(tcoords->GetPointer(0), shading.tcoords.data(), n * sizeof(glm::vec2));
     poly_->GetPointData()->SetTCoords(tcoords);
+
+    vtkNew<vtkUnsignedCharArray> texels;
+    texels->SetNumberOfComponents(4);
+    texels->SetNumberOfTuples(static_cast<vtkIdType>(texture.rgba.size()));
+    std::memcpy(texels->GetPointer(0), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
+    texture_image_->SetDimensions(texture.side, texture.side, 1);
+    texture_image_->GetPointData()->SetScalars(texels);
+    texture_->SetInputData(texture_image_);
+    // Bilinear only: on llvmpipe mipmaps cost about 20 ms per 1280x720 frame and 8x anisotropic
+    // filtering about 70 ms, with no visible gain in oblique views (a texel is about a pixel
+    // at the distances the LOD threshold keeps fine).
+    texture_->InterpolateOn();
+    texture_->MipmapOff();
+    texture_->EdgeClampOn();
+    texture_->RepeatOff();
+    texture_->SetColorModeToDirectScalars();
   }
 
   if (settings.order == DrawOrder::kBsp) {
@@ -125,65 +141,38 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
   }
   mapper_->SetInputData(poly_);
-  mapper_->ScalarVisibilityOn();
   mapper_->SetColorModeToDirectScalars();
-  if (textured) {
-    mapper_->ScalarVisibilityOff();  // the texture gives the colour
-  } else if (settings.lod_colors) {
-    mapper_->SetScalarModeToUseCellFieldData();
-    mapper_->SelectColorArray("lod_rgba");
-  } else {
-    mapper_->SetScalarModeToUsePointData();
-  }
   mapper_->InterpolateScalarsBeforeMappingOff();
 
   actor_->SetMapper(mapper_);
   actor_->ForceOpaqueOn();  // drawn in the opaque pass, in our order
   vtkProperty* property = actor_->GetProperty();
   property->LightingOff();  // the shading is baked into the colours (terrain_colors.h)
+  property->SetColor(1.0, 1.0, 1.0);
   if (settings.wireframe) property->SetRepresentationToWireframe();
-  if (textured) {
-    vtkNew<vtkUnsignedCharArray> texels;
-    texels->SetNumberOfComponents(4);
-    texels->SetNumberOfTuples(static_cast<vtkIdType>(texture.rgba.size()));
-    std::memcpy(texels->GetPointer(0), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
-    vtkNew<vtkImageData> image;
-    image->SetDimensions(texture.side, texture.side, 1);
-    image->GetPointData()->SetScalars(texels);
-    vtkNew<vtkTexture> colors;
-    colors->SetInputData(image);
-    // Bilinear only: on llvmpipe mipmaps cost about 20 ms per 1280x720 frame and 8x anisotropic
-    // filtering about 70 ms, with no visible gain in oblique views (a texel is about a pixel
-    // at the distances the LOD threshold keeps fine).
-    colors->InterpolateOn();
-    colors->MipmapOff();
-    colors->EdgeClampOn();
-    colors->RepeatOff();
-    colors->SetColorModeToDirectScalars();
-    actor_->SetTexture(colors);
-    property->SetColor(1.0, 1.0, 1.0);
-  }
   if (settings.haze_distance > 0.0) {
-    // After VTK's own colour, lighting and texture code: fade by depth, linearised from the
-    // clipping range.
+    // The haze of each vertex from its depth along the view axis (clip-space w), interpolated,
+    // and mixed in after VTK's own colour and texture code. Per fragment (depth linearised
+    // from gl_FragCoord.z) it cost about 18 ms more per 1280x720 frame on llvmpipe, where
+    // back-to-front drawing shades every layer of the terrain; per vertex the difference is
+    // invisible (the fade is smooth and coarse triangles are far).
     vtkShaderProperty* shader = actor_->GetShaderProperty();
-    shader->AddFragmentShaderReplacement("//VTK::TCoord::Impl", true,
-                                         "//VTK::TCoord::Impl\n"
-                                         "  {\n"
-                                         "    float zn = 2.0 * gl_FragCoord.z - 1.0;\n"
-                                         "    float depth = 2.0 * hazeNear * hazeFar / (hazeFar + hazeNear - zn * (hazeFar - hazeNear));\n"
-                                         "    float haze = 0.85 * (1.0 - exp(-depth / hazeDistance));\n"
-                                         "    gl_FragData[0].rgb = mix(gl_FragData[0].rgb, hazeColor, haze);\n"
-                                         "  }\n",
-                                         false);
-    vtkUniforms* uniforms = shader->GetFragmentCustomUniforms();
-    uniforms->SetUniformf("hazeDistance", static_cast<float>(settings.haze_distance));
+    shader->AddVertexShaderReplacement("//VTK::PositionVC::Dec", true,
+                                       "//VTK::PositionVC::Dec\nout float hazeAmount;\n", false);
+    shader->AddVertexShaderReplacement(
+        "//VTK::PositionVC::Impl", true,
+        "//VTK::PositionVC::Impl\n  hazeAmount = 0.85 * (1.0 - exp(-gl_Position.w / hazeDistance));\n", false);
+    shader->AddFragmentShaderReplacement("//VTK::PositionVC::Dec", true,
+                                         "//VTK::PositionVC::Dec\nin float hazeAmount;\n", false);
+    shader->AddFragmentShaderReplacement(
+        "//VTK::TCoord::Impl", true,
+        "//VTK::TCoord::Impl\n  gl_FragData[0].rgb = mix(gl_FragData[0].rgb, hazeColor, hazeAmount);\n", false);
+    shader->GetVertexCustomUniforms()->SetUniformf("hazeDistance", static_cast<float>(settings.haze_distance));
     const float color[3] = {settings.haze_color[0] / 255.0f, settings.haze_color[1] / 255.0f,
                             settings.haze_color[2] / 255.0f};
-    uniforms->SetUniform3f("hazeColor", color);
-    uniforms->SetUniformf("hazeNear", 1.0f);
-    uniforms->SetUniformf("hazeFar", 2.0f);
+    shader->GetFragmentCustomUniforms()->SetUniform3f("hazeColor", color);
   }
+  apply_color_mode();
 
   renderer_->AddActor(actor_);
   renderer_->UseDepthPeelingOff();
@@ -200,7 +189,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
 
   require_x_display();
   window_->SetDisplayId(shared_display());  // not owned: VTK leaves it open
-  window_->SetOffScreenRendering(1);
+  window_->SetOffScreenRendering(settings.offscreen ? 1 : 0);
   window_->SetMultiSamples(0);
   window_->SetAlphaBitPlanes(0);
   window_->SetSize(settings.width, settings.height);
@@ -213,11 +202,6 @@ vtkCamera* TerrainRenderer::camera() { return renderer_->GetActiveCamera(); }
 
 void TerrainRenderer::set_camera(const mrbsp::Camera& camera, double far_plane) {
   apply_camera(camera, far_plane, *renderer_->GetActiveCamera());
-  if (settings_.haze_distance > 0.0) {
-    vtkUniforms* uniforms = actor_->GetShaderProperty()->GetFragmentCustomUniforms();
-    uniforms->SetUniformf("hazeNear", static_cast<float>(camera.near_plane));
-    uniforms->SetUniformf("hazeFar", static_cast<float>(far_plane));
-  }
 }
 
 void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
@@ -258,6 +242,66 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
       rgba[t] = shaded(lod_color(lv), s);
     }
     poly_->GetCellData()->AddArray(colors);
+  }
+  poly_->Modified();
+}
+
+void TerrainRenderer::apply_color_mode() {
+  const bool textured = texture_side_ > 0 && !settings_.lod_colors;
+  actor_->SetTexture(textured ? texture_.GetPointer() : nullptr);
+  if (textured) {
+    mapper_->ScalarVisibilityOff();  // the texture gives the colour
+  } else if (settings_.lod_colors) {
+    mapper_->ScalarVisibilityOn();
+    mapper_->SetScalarModeToUseCellFieldData();
+    mapper_->SelectColorArray("lod_rgba");
+  } else {
+    mapper_->ScalarVisibilityOn();
+    mapper_->SetScalarModeToUsePointData();
+  }
+  if (settings_.haze_distance > 0.0) {  // the shader replacement exists: fade, or not at all
+    const double distance = settings_.lod_colors ? 1e30 : settings_.haze_distance;
+    actor_->GetShaderProperty()->GetVertexCustomUniforms()->SetUniformf("hazeDistance", static_cast<float>(distance));
+  }
+}
+
+void TerrainRenderer::set_lod_colors(bool on) {
+  if (on == settings_.lod_colors) return;
+  settings_.lod_colors = on;
+  apply_color_mode();
+}
+
+void TerrainRenderer::set_wireframe(bool on) {
+  settings_.wireframe = on;
+  if (on) {
+    actor_->GetProperty()->SetRepresentationToWireframe();
+  } else {
+    actor_->GetProperty()->SetRepresentationToSurface();
+  }
+}
+
+void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+                                       const ColorTexture& texture) {
+  const std::size_t n = positions.size();
+  if (n != static_cast<std::size_t>(poly_->GetNumberOfPoints()) || shading.rgba.size() != n ||
+      shading.normals.size() != n || shading.shade.size() != n || texture.side != texture_side_ ||
+      texture.rgba.size() != static_cast<std::size_t>(texture.side) * texture.side) {
+    throw std::invalid_argument("TerrainRenderer::replace_vertices: " + std::to_string(n) + " positions for " +
+                                std::to_string(poly_->GetNumberOfPoints()) + " vertices, or attributes that differ");
+  }
+  auto copy = [](vtkDataArray* to, const void* from, std::size_t bytes) {
+    std::memcpy(to->GetVoidPointer(0), from, bytes);
+    to->Modified();
+  };
+  copy(poly_->GetPoints()->GetData(), positions.data(), n * sizeof(glm::vec3));
+  poly_->GetPoints()->Modified();
+  copy(poly_->GetPointData()->GetNormals(), shading.normals.data(), n * sizeof(glm::vec3));
+  copy(poly_->GetPointData()->GetScalars(), shading.rgba.data(), n * sizeof(Rgba));
+  shade_ = shading.shade;
+  point_rgba_ = shading.rgba;
+  if (texture_side_ > 0) {
+    copy(texture_image_->GetPointData()->GetScalars(), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
+    texture_image_->Modified();
   }
   poly_->Modified();
 }

@@ -19,10 +19,12 @@
 
 class vtkActor;
 class vtkCamera;
+class vtkImageData;
 class vtkPolyData;
 class vtkPolyDataMapper;
 class vtkRenderer;
 class vtkRenderWindow;
+class vtkTexture;
 
 namespace terravol::app {
 
@@ -42,16 +44,19 @@ struct RenderSettings {
   Rgb background_top{95, 145, 210};     // used when gradient
   bool gradient = true;                 // a sky gradient, bottom to top
   // Aerial perspective: colours fade toward haze_color with depth d (metres along the view
-  // axis) by 1 - exp(-d / haze_distance), at most 85%; 0 turns it off. Applied in the fragment
-  // shader, so the vertex colours (and --export-vtp) are unhazed.
+  // axis) by 1 - exp(-d / haze_distance), at most 85%; 0 turns it off. Computed per vertex in
+  // the vertex shader and mixed in by the fragment shader, so the vertex colours (and
+  // --export-vtp) are unhazed.
   double haze_distance = 0.0;
   Rgb haze_color{214, 226, 238};
+  // false: an on-screen window (terravol view), whose interactor the caller attaches.
+  bool offscreen = true;
 };
 
 // The lattice colours as one texture (side x side texels, row 0 south): when given, the
 // terrain's colour at every pixel comes from the full-resolution colours whatever LOD the
 // geometry is drawn at (bilinear, no mipmaps), instead of being interpolated between the
-// vertices of coarse triangles. Not used with lod_colors.
+// vertices of coarse triangles. Not drawn while lod_colors is on.
 struct ColorTexture {
   int side = 0;                // n + 1; 0: no texture, per-vertex colours
   std::span<const Rgba> rgba;  // side * side
@@ -65,7 +70,8 @@ void require_x_display();
 class TerrainRenderer {
  public:
   // positions: TerrainTree::positions(); shading: per vertex, the same count (vertex_shading).
-  // Opens an offscreen render window on the process's X connection (require_x_display).
+  // Opens a render window (offscreen unless settings.offscreen is false) on the process's X
+  // connection (require_x_display).
   // Throws std::invalid_argument when the counts differ or the size is not positive, and
   // std::runtime_error without an X display.
   TerrainRenderer(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
@@ -84,6 +90,18 @@ class TerrainRenderer {
   // Draws one frame and waits for the GPU to finish it; returns wall milliseconds.
   double render();
 
+  // Display switches for the interactive viewer; they take effect at the next set_frame() and
+  // render(). LOD colours replace the texture and turn the haze off while on.
+  void set_lod_colors(bool on);
+  void set_wireframe(bool on);
+
+  // Sliding (terravol view): every vertex gets a new position and attributes (the tree's
+  // positions() after TerrainTree::slide(), the shading and texture of the moved window); the
+  // counts and the texture side must be those given to the constructor, else
+  // std::invalid_argument. The triangle list is kept until the next set_frame().
+  void replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+                        const ColorTexture& texture = {});
+
   // The last rendered image, encoded as PNG.
   std::vector<std::uint8_t> png() const;
 
@@ -91,13 +109,20 @@ class TerrainRenderer {
   // order, and with lod_colors the cell array "lod_rgba" and always "level" (cell data).
   vtkPolyData* scene() { return poly_; }
   vtkCamera* camera();
+  vtkRenderer* renderer() { return renderer_; }
+  vtkRenderWindow* window() { return window_; }
   const RenderSettings& settings() const { return settings_; }
 
  private:
+  void apply_color_mode();
+
   RenderSettings settings_;
   std::vector<float> shade_;      // per vertex, for --lod-colors
   std::vector<Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
+  int texture_side_ = 0;          // 0: no texture
   vtkNew<vtkPolyData> poly_;
+  vtkNew<vtkImageData> texture_image_;
+  vtkNew<vtkTexture> texture_;
   vtkSmartPointer<vtkPolyDataMapper> mapper_;
   vtkNew<vtkActor> actor_;
   vtkNew<vtkRenderer> renderer_;

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
+
+#include <glm/geometric.hpp>
 
 #include "io/void_fill.h"
 
@@ -44,57 +47,115 @@ WindowChoice choose_window(int rows, int cols, double row, double col, int max_c
   return w;
 }
 
+WindowChoice plan_slide(const WindowChoice& current, int rows, int cols, double row, double col, int step,
+                        double margin) {
+  const int n = current.cells;
+  // The new first line of one axis: `first` moved by whole steps toward `at`, kept in [0, last].
+  auto move = [&](int first, double at, int samples) {
+    const double offset = at - first;
+    if (offset >= margin * n && offset <= (1.0 - margin) * n) return first;
+    const int last = samples - 1 - n;
+    int steps = static_cast<int>(std::lround((at - (first + n / 2.0)) / step));
+    while (steps > 0 && first + steps * step > last) --steps;
+    while (steps < 0 && first + steps * step < 0) ++steps;
+    return first + steps * step;
+  };
+  WindowChoice w = current;
+  w.row0 = move(current.row0, row, rows);
+  w.col0 = move(current.col0, col, cols);
+  return w;
+}
+
 int default_levels(int cells) { return std::max(1, floor_log2(cells) - 2); }
 
 TerrainScene::TerrainScene(const io::Mosaic& mosaic, const WindowChoice& window, int levels)
     : window_(window), frame_(centre_frame(mosaic, window)), tree_(build(*this, mosaic, levels)) {}
 
 mrbsp::TerrainTree TerrainScene::build(TerrainScene& s, const io::Mosaic& mosaic, int levels) {
-  const int n = s.window_.cells, side = n + 1;
+  const int n = s.window_.cells;
   const int k = floor_log2(n);
   if (levels < 1 || levels > k + 1) {
     throw std::invalid_argument("--levels " + std::to_string(levels) + ": a window of " + std::to_string(n) +
                                 " cells has 1.." + std::to_string(k + 1) + " levels");
   }
+  const mrbsp::TerrainWindow tw = s.adopt(read_scene_window(mosaic, s.window_, s.frame_));
+  const auto t0 = std::chrono::steady_clock::now();
+  mrbsp::TerrainTree tree(tw, levels);
+  s.build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return tree;
+}
+
+void TerrainScene::slide(const io::Mosaic& mosaic, const WindowChoice& window) {
+  if (window.cells != window_.cells) {
+    throw std::invalid_argument("TerrainScene::slide: a window of " + std::to_string(window.cells) +
+                                " cells for a scene of " + std::to_string(window_.cells));
+  }
+  slide(read_scene_window(mosaic, window, frame_));
+}
+
+void TerrainScene::slide(SceneWindow&& moved) {
+  if (moved.window.cells != window_.cells || moved.xs.size() != xs_.size() || moved.z.size() != z_.size()) {
+    throw std::invalid_argument("TerrainScene::slide: a window of " + std::to_string(moved.window.cells) +
+                                " cells for a scene of " + std::to_string(window_.cells));
+  }
+  tree_.slide(adopt(std::move(moved)));
+}
+
+mrbsp::TerrainWindow TerrainScene::adopt(SceneWindow&& w) {
+  window_ = w.window;
+  bounds_ = w.bounds;
+  lat_step_ = w.lat_step;
+  lon_step_ = w.lon_step;
+  filled_ = w.filled;
+  xs_ = std::move(w.xs);
+  ys_ = std::move(w.ys);
+  heights_ = std::move(w.heights);
+  z_ = std::move(w.z);
+  min_z_ = w.min_z;
+  max_z_ = w.max_z;
+  mrbsp::TerrainWindow tw;
+  tw.cells = window_.cells;
+  tw.xs = xs_;
+  tw.ys = ys_;
+  tw.z = z_;
+  return tw;
+}
+
+SceneWindow read_scene_window(const io::Mosaic& mosaic, const WindowChoice& window, const io::SceneFrame& frame) {
+  const int n = window.cells, side = n + 1;
+  SceneWindow w;
+  w.window = window;
+  io::Grid grid = mosaic.read_window(window.row0, window.col0, side, side);
+  w.filled = io::fill_voids(grid);
+
   const io::Georef& g = mosaic.georef();
-  s.lat_step_ = g.dy;
-  s.lon_step_ = g.dx;
-  s.bounds_.north = g.y0 - s.window_.row0 * g.dy;
-  s.bounds_.south = s.bounds_.north - n * g.dy;
-  s.bounds_.west = g.x0 + s.window_.col0 * g.dx;
-  s.bounds_.east = s.bounds_.west + n * g.dx;
+  w.lat_step = g.dy;
+  w.lon_step = g.dx;
+  w.bounds.north = g.y0 - window.row0 * g.dy;
+  w.bounds.south = w.bounds.north - n * g.dy;
+  w.bounds.west = g.x0 + window.col0 * g.dx;
+  w.bounds.east = w.bounds.west + n * g.dx;
 
-  io::Grid grid = mosaic.read_window(s.window_.row0, s.window_.col0, side, side);
-  s.filled_ = io::fill_voids(grid);
-
-  s.xs_.resize(side);
-  s.ys_.resize(side);
-  for (int i = 0; i < side; ++i) s.xs_[i] = s.frame_.x_of_lon(s.bounds_.west + i * g.dx);
-  for (int j = 0; j < side; ++j) s.ys_[j] = s.frame_.y_of_lat(s.bounds_.south + j * g.dy);
-  s.heights_.resize(static_cast<std::size_t>(side) * side);
-  s.z_.resize(s.heights_.size());
-  s.min_z_ = std::numeric_limits<float>::max();
-  s.max_z_ = std::numeric_limits<float>::lowest();
+  w.xs.resize(side);
+  w.ys.resize(side);
+  for (int i = 0; i < side; ++i) w.xs[i] = frame.x_of_lon(w.bounds.west + i * g.dx);
+  for (int j = 0; j < side; ++j) w.ys[j] = frame.y_of_lat(w.bounds.south + j * g.dy);
+  w.heights.resize(static_cast<std::size_t>(side) * side);
+  w.z.resize(w.heights.size());
+  w.min_z = std::numeric_limits<float>::max();
+  w.max_z = std::numeric_limits<float>::lowest();
   for (int j = 0; j < side; ++j) {
     const int grid_row = n - j;  // io grids have row 0 north; the tree wants row 0 south
     for (int i = 0; i < side; ++i) {
       const std::size_t t = static_cast<std::size_t>(j) * side + i;
       const float h = grid.heights[grid.index(grid_row, i)];
-      s.heights_[t] = h;
-      s.z_[t] = static_cast<float>(h - s.frame_.curvature_drop(s.xs_[i], s.ys_[j]));
-      s.min_z_ = std::min(s.min_z_, s.z_[t]);
-      s.max_z_ = std::max(s.max_z_, s.z_[t]);
+      w.heights[t] = h;
+      w.z[t] = static_cast<float>(h - frame.curvature_drop(w.xs[i], w.ys[j]));
+      w.min_z = std::min(w.min_z, w.z[t]);
+      w.max_z = std::max(w.max_z, w.z[t]);
     }
   }
-  mrbsp::TerrainWindow tw;
-  tw.cells = n;
-  tw.xs = s.xs_;
-  tw.ys = s.ys_;
-  tw.z = s.z_;
-  const auto t0 = std::chrono::steady_clock::now();
-  mrbsp::TerrainTree tree(tw, levels);
-  s.build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return tree;
+  return w;
 }
 
 double TerrainScene::ground_height(double lat, double lon) const {
@@ -106,6 +167,15 @@ double TerrainScene::ground_height(double lat, double lon) const {
   const double fu = u - i, fv = v - j;
   auto h = [&](int jj, int ii) { return static_cast<double>(heights_[static_cast<std::size_t>(jj) * side + ii]); };
   return (1 - fv) * ((1 - fu) * h(j, i) + fu * h(j, i + 1)) + fv * ((1 - fu) * h(j + 1, i) + fu * h(j + 1, i + 1));
+}
+
+double TerrainScene::far_plane(const glm::dvec3& eye) const {
+  double far = 0.0;
+  for (double x : {xs_.front(), xs_.back()})
+    for (double y : {ys_.front(), ys_.back()})
+      for (double z : {static_cast<double>(min_z_), static_cast<double>(max_z_)})
+        far = std::max(far, glm::length(glm::dvec3(x, y, z) - eye));
+  return far * 1.05 + 100.0;
 }
 
 }  // namespace terravol::app

@@ -5,6 +5,8 @@
 #include <span>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "io/grid.h"
 #include "io/mosaic.h"
 #include "io/scene_frame.h"
@@ -26,6 +28,16 @@ struct WindowChoice {
 // mosaic is smaller than 3 x 3 samples.
 WindowChoice choose_window(int rows, int cols, double row, double col, int max_cells);
 
+// Sliding (Wiley et al. 1997, section 4.3): the window to move to when the camera, at the
+// fractional lattice position (row, col), is within `margin` (a share of the side) of an edge of
+// `current`. Each axis on which the camera is that near an edge moves by the whole number of
+// `step` cells (the coarsest level's cell, so that every level's lattice stays on the same
+// mosaic samples) that brings the camera nearest the window's centre, less whole steps where the
+// mosaic (rows x cols samples) ends. Returns `current` when no move is needed or possible.
+// Preconditions: step >= 1, 0 < margin < 0.5.
+WindowChoice plan_slide(const WindowChoice& current, int rows, int cols, double row, double col, int step,
+                        double margin = 0.25);
+
 // The default level count for a window of `cells` = 2^k cells: k - 2, so that the coarsest
 // level is 8 x 8 cells; at least 1.
 int default_levels(int cells);
@@ -35,6 +47,23 @@ struct WindowBounds {
   double south = 0, north = 0, west = 0, east = 0;
 };
 
+// The lattice of one window placed in a scene frame: what a TerrainScene holds (see its
+// accessors for the conventions), and what a slide reads ahead, possibly on another thread.
+struct SceneWindow {
+  WindowChoice window;
+  WindowBounds bounds;
+  double lat_step = 0, lon_step = 0;  // degrees per row and column
+  std::size_t filled = 0;             // samples filled by fill_voids
+  std::vector<double> xs, ys;
+  std::vector<float> heights, z;
+  float min_z = 0, max_z = 0;
+};
+
+// Reads `window` from the mosaic (read_window), fills its voids and the samples no tile covers
+// (fill_voids) and places it in `frame`. Touches nothing but the mosaic (whose tile cache is
+// not thread-safe: one reader at a time). Throws io::FormatError from the mosaic.
+SceneWindow read_scene_window(const io::Mosaic& mosaic, const WindowChoice& window, const io::SceneFrame& frame);
+
 class TerrainScene {
  public:
   // Reads the window from the mosaic (read_window), fills its voids and the samples no tile
@@ -42,6 +71,16 @@ class TerrainScene {
   // the tree with `levels` LOD levels (1 <= levels <= k + 1). Throws io::FormatError from the
   // mosaic and std::invalid_argument for a bad level count.
   TerrainScene(const io::Mosaic& mosaic, const WindowChoice& window, int levels);
+
+  // Sliding (section 4.3): reads `window` (same cells as before) from the mosaic, recomputes
+  // xs, ys, heights and z in the SAME scene frame (its origin does not move, so neither does
+  // anything already placed in it, the camera included) and slides the tree. Throws
+  // std::invalid_argument when the size differs, and io::FormatError from the mosaic, in which
+  // case the scene keeps its old window.
+  void slide(const io::Mosaic& mosaic, const WindowChoice& window);
+  // The same with the window read ahead: `moved` from read_scene_window(mosaic, window,
+  // frame()). Throws std::invalid_argument when its size differs.
+  void slide(SceneWindow&& moved);
 
   const io::SceneFrame& frame() const { return frame_; }
   const WindowChoice& window() const { return window_; }
@@ -66,8 +105,13 @@ class TerrainScene {
   // clamped to its edge.
   double ground_height(double lat, double lon) const;
 
+  // A far clipping distance for an eye (scene frame): the farthest any window sample can be,
+  // plus 5% and 100 m.
+  double far_plane(const glm::dvec3& eye) const;
+
  private:
   static mrbsp::TerrainTree build(TerrainScene& self, const io::Mosaic& mosaic, int levels);
+  mrbsp::TerrainWindow adopt(SceneWindow&& w);  // takes w's lattice; returns views of it for the tree
   WindowChoice window_;
   WindowBounds bounds_;
   double lat_step_ = 0, lon_step_ = 0;  // degrees per row and column

@@ -1,0 +1,81 @@
+// `terravol view DEM... [--camera LAT,LON,ALT,HEADING,PITCH]`: the interactive viewer
+// (app/viewer.h) on an X display.
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "app/commands.h"
+#include "app/render_options.h"
+#include "app/viewer.h"
+
+namespace terravol::app {
+
+void add_view_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("view", "Fly over the terrain of DEM files in a window (needs an X display)");
+  cmd->footer(std::string("Keys:\n") + kViewKeys);
+  struct Raw {
+    ViewOptions o;
+    std::string camera, size = "1280x720", metric = "error", tint = "atlas";
+    double threshold = 0.0;
+    bool no_slide = false;
+  };
+  auto raw = std::make_shared<Raw>();
+  ViewOptions& o = raw->o;
+  cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic)")->required();
+  cmd->add_option("--camera", raw->camera,
+                  "LAT,LON,ALT,HEADING,PITCH: degrees, metres (in the DEM's datum; above ground with --agl), "
+                  "heading clockwise from north, pitch above the horizon (default: 1500 m above the "
+                  "mosaic's centre, looking north)");
+  cmd->add_flag("--agl", o.agl, "ALT is metres above the ground under the camera");
+  cmd->add_option("--size", raw->size, "Window size WIDTHxHEIGHT, pixels")->capture_default_str();
+  cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
+  cmd->add_option("--lod-metric", raw->metric, "LOD metric at the start: error or area (key M switches)")
+      ->capture_default_str();
+  auto* threshold = cmd->add_option("--threshold", raw->threshold,
+                                    "LOD threshold at the start: pixels of screen-space error (default 2) or, "
+                                    "with --lod-metric area, square pixels (default 500)");
+  auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
+  cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
+  cmd->add_option("--speed", o.flight.speed_factor,
+                  "Flight speed: metres per second for each metre above the ground")
+      ->capture_default_str();
+  cmd->add_flag("--lod-colors", o.lod_colors, "Start with each LOD level in its own colour (key L)");
+  cmd->add_flag("--wireframe", o.wireframe, "Start in wireframe (key T)");
+  cmd->add_flag("--no-slide", raw->no_slide, "Start with automatic sliding of the window off (key G)");
+  cmd->add_option("--haze", o.haze_km, "Aerial perspective: distance (km) at which 63% of the colour fades; 0: none")
+      ->capture_default_str();
+  cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
+      ->capture_default_str();
+  cmd->add_option("--status", o.status, "After every frame, write the viewer's state to this JSON file");
+  cmd->add_option("--screenshot", o.screenshot,
+                  "Where key P writes the view (PNG, replaced each time; default terravol-view-NNN.png here)");
+  cmd->callback([raw, levels, threshold] {
+    ViewOptions& opt = raw->o;
+    if (!raw->camera.empty()) opt.pose = parse_camera_pose(raw->camera);
+    parse_size(raw->size, opt.width, opt.height);
+    opt.traversal.metric = parse_metric(raw->metric);
+    opt.shading.tint = parse_tint(raw->tint);
+    opt.auto_slide = !raw->no_slide;
+    if (threshold->count() == 0) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
+    if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
+      throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
+    }
+    opt.traversal.threshold_px = static_cast<float>(raw->threshold);
+    if (!(opt.fov_y_deg > 0.0 && opt.fov_y_deg < 180.0)) {
+      throw std::invalid_argument("--fov " + std::to_string(opt.fov_y_deg) + ": must be within (0, 180) degrees");
+    }
+    if (opt.max_window < 2 || (opt.max_window & (opt.max_window - 1)) != 0) {
+      throw std::invalid_argument("--window " + std::to_string(opt.max_window) + ": must be a power of two >= 2");
+    }
+    if (!(opt.haze_km >= 0.0) || !std::isfinite(opt.haze_km)) throw std::invalid_argument("--haze: must be a distance >= 0 km");
+    if (!(opt.flight.speed_factor > 0.0) || !std::isfinite(opt.flight.speed_factor)) {
+      throw std::invalid_argument("--speed: must be a positive number");
+    }
+    if (levels->count() > 0 && opt.levels < 1) throw std::invalid_argument("--levels " + std::to_string(opt.levels) + ": must be >= 1");
+    if (opt.agl && !opt.pose) throw std::invalid_argument("--agl needs --camera");
+    run_viewer(opt);
+  });
+}
+
+}  // namespace terravol::app

@@ -1,0 +1,48 @@
+// `terravol view`: the interactive viewer. An on-screen VTK window over the terrain of a DEM
+// mosaic, drawn through the MRBSP tree in back-to-front order, with flight controls, an LOD
+// threshold slider, a text overlay, and a window that slides over the mosaic with the camera
+// (Wiley et al. 1997, section 4.3). Key bindings: kViewKeys.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "app/camera.h"
+#include "app/flight.h"
+#include "app/terrain_colors.h"
+#include "mrbsp/terrain_tree.h"
+
+namespace terravol::app {
+
+struct ViewOptions {
+  std::vector<std::filesystem::path> dems;  // files or folders, one mosaic
+  std::optional<CameraPose> pose;           // none: above the mosaic's centre, looking north
+  bool agl = false;                         // pose->alt is above the ground under the camera
+  int width = 1280, height = 720;           // window, pixels
+  double fov_y_deg = 45.0;                  // vertical, (0, 180)
+  mrbsp::TraversalOptions traversal;        // metric and its threshold at the start
+  int levels = 0;                           // 0: default_levels(window)
+  int max_window = 1024;                    // cells, a power of two >= 2
+  ShadingOptions shading;
+  double haze_km = 60.0;                    // 0: none
+  FlightSettings flight;                    // speed_factor from --speed
+  bool lod_colors = false, wireframe = false;
+  bool auto_slide = true;
+  // After every rendered frame, a small JSON of the viewer's state (written to a temporary
+  // name and renamed); empty: none.
+  std::filesystem::path status;
+  // Where the screenshot key writes (replaced each time, atomically); empty: the next free
+  // terravol-view-NNN.png in the current folder.
+  std::filesystem::path screenshot;
+};
+
+// The key bindings, one per line, for --help and the overlay's help panel.
+extern const char* const kViewKeys;
+
+// Opens the window and runs until the quit key (or the window is closed). Prints a timing
+// summary on stdout at the end. Throws std::runtime_error (one line) for a camera outside the
+// mosaic or under the ground, or without an X display; io::FormatError from the DEMs.
+void run_viewer(const ViewOptions& options);
+
+}  // namespace terravol::app

@@ -1,0 +1,585 @@
+// `terravol view` as a person uses it: the real window on the X display, driven with xdotool
+// (keys held and tapped, mouse drags on the view and on the slider), observed through the
+// viewer's --status file and its screenshots. Each test starts its own viewer and kills it in
+// teardown. The viewers of different tests (ctest runs them in parallel) take turns through a
+// lock file, since keyboard focus is one per display.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "image_compare.h"
+#include "require_display.h"
+#include "run_command.h"
+#include "temp_dir.h"
+
+namespace terravol {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+constexpr double kPi = 3.14159265358979323846;
+
+std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Runs a shell command with a time limit; returns its exit status and stdout.
+int shell(const std::string& command, std::string* out = nullptr) {
+  FILE* pipe = popen(("timeout 20 " + command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  std::string text;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) text += buffer;
+  const int raw = pclose(pipe);
+  if (out != nullptr) *out = text;
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+}
+
+bool have_xdotool() { return shell("xdotool version") == 0; }
+
+#define TERRAVOL_REQUIRE_XDOTOOL()                                                                  \
+  do {                                                                                              \
+    TERRAVOL_REQUIRE_DISPLAY();                                                                     \
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/packages.txt lists it)"; \
+  } while (0)
+
+// One viewer process on $DISPLAY, its status file and the keys and buttons the test holds.
+class Viewer {
+ public:
+  // Starts `terravol view ARGS --status F --screenshot P` and waits for its window and first
+  // frame; puts the pointer in the middle of the window and gives it the keyboard focus.
+  explicit Viewer(const std::string& args) {
+    lock_ = ::open(("/tmp/terravol-view-test" + display_tag() + ".lock").c_str(), O_CREAT | O_RDWR, 0666);
+    if (lock_ >= 0) ::flock(lock_, LOCK_EX);  // one viewer on the display at a time
+    status_path_ = dir_.path() / "status.json";
+    shot_path_ = dir_.path() / "shot.png";
+    std::vector<std::string> argv{TERRAVOL_EXE, "view"};
+    std::istringstream words(args + " --status " + status_path_.string() + " --screenshot " + shot_path_.string());
+    for (std::string w; words >> w;) argv.push_back(w);
+    const std::string out = (dir_.path() / "stdout").string(), err = (dir_.path() / "stderr").string();
+    pid_ = fork();
+    if (pid_ == 0) {
+      std::vector<char*> cargv;
+      for (auto& a : argv) cargv.push_back(a.data());
+      cargv.push_back(nullptr);
+      if (!std::freopen(out.c_str(), "w", stdout) || !std::freopen(err.c_str(), "w", stderr)) _exit(126);
+      execv(cargv[0], cargv.data());
+      _exit(127);
+    }
+  }
+
+  ~Viewer() {
+    for (const auto& k : keys_down_) shell("xdotool keyup " + k);
+    if (button_down_) shell("xdotool mouseup 1");
+    if (running()) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+    if (lock_ >= 0) ::close(lock_);
+  }
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+
+  // Waits for the first frame and the window; false (with a message) when they do not come.
+  ::testing::AssertionResult start() {
+    if (pid_ <= 0) return ::testing::AssertionFailure() << "fork failed";
+    if (!wait_for([](const json& s) { return s["frame"].get<int>() >= 1; }, 30.0)) {
+      return ::testing::AssertionFailure() << "no status after 30 s; stderr: " << slurp(dir_.path() / "stderr");
+    }
+    std::string ids;
+    for (int attempt = 0; attempt < 50 && ids.empty(); ++attempt) {
+      shell("xdotool search --onlyvisible --name '^Terravol view'", &ids);
+      if (ids.find_first_not_of("0123456789\n") != std::string::npos) ids.clear();
+      if (ids.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    std::istringstream lines(ids);
+    for (std::string line; std::getline(lines, line);) {
+      if (!line.empty()) window_ = line;  // the newest is listed last
+    }
+    if (window_.empty()) return ::testing::AssertionFailure() << "no window named 'Terravol view'";
+    const json s = status();
+    width_ = s["size"][0].get<int>();
+    height_ = s["size"][1].get<int>();
+    xdo("mousemove --window " + window_ + " " + std::to_string(width_ / 2) + " " + std::to_string(height_ / 2));
+    xdo("windowfocus --sync " + window_);
+    return ::testing::AssertionSuccess();
+  }
+
+  bool running() {
+    if (exited_) return false;
+    int raw = 0;
+    if (waitpid(pid_, &raw, WNOHANG) == pid_) {
+      exited_ = true;
+      exit_status_ = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+      return false;
+    }
+    return true;
+  }
+
+  // The exit status once the process has ended, or -1 after `seconds`.
+  int wait_exit(double seconds) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    while (running() && Clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return exited_ ? exit_status_ : -1;
+  }
+
+  // The last status written (an empty object before the first).
+  json status() const {
+    std::ifstream in(status_path_);
+    if (!in) return json::object();
+    try {
+      return json::parse(in);
+    } catch (const json::exception&) {
+      return json::object();
+    }
+  }
+
+  // Polls the status file until `pred` holds (true) or `seconds` pass (false). Every distinct
+  // frame seen is passed to `seen` if given.
+  bool wait_for(const std::function<bool(const json&)>& pred, double seconds,
+                const std::function<void(const json&)>& seen = nullptr) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    int last = -1;
+    while (Clock::now() < end) {
+      const json s = status();
+      if (s.contains("frame")) {
+        if (seen && s["frame"].get<int>() != last) seen(s);
+        last = s["frame"].get<int>();
+        if (pred(s)) return true;
+      }
+      if (!running()) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
+
+  // Waits for a frame after the current one: the effect of what was just done.
+  json next_frame(double seconds = 10.0) {
+    const int now = status().value("frame", 0);
+    json got;
+    wait_for(
+        [&](const json& s) {
+          got = s;
+          return s["frame"].get<int>() > now;
+        },
+        seconds);
+    return got;
+  }
+
+  // Waits until the viewer is idle (no key held, nothing more to draw) and its frame count
+  // has stayed put for a moment (events still in flight are handled).
+  json settle() {
+    json last = status();
+    auto still_since = Clock::now();
+    const auto end = Clock::now() + std::chrono::seconds(15);
+    while (Clock::now() < end && running()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      const json s = status();
+      if (s.value("frame", -1) != last.value("frame", -1)) {
+        last = s;
+        still_since = Clock::now();
+      } else if (last.value("idle", false) && Clock::now() - still_since > std::chrono::milliseconds(80)) {
+        break;
+      }
+    }
+    return last;
+  }
+
+  void xdo(const std::string& args) {
+    std::string out;
+    const int rc = shell("xdotool " + args, &out);
+    EXPECT_EQ(rc, 0) << "xdotool " << args << ": " << out;
+  }
+  void tap(const std::string& key) {
+    const int before = status().value("frame", 0);
+    xdo("key " + key);
+    wait_for([&](const json& s) { return s["frame"].get<int>() > before; }, 10.0);
+  }
+  void key_down(const std::string& key) {
+    xdo("keydown " + key);
+    keys_down_.insert(key);
+  }
+  void key_up(const std::string& key) {
+    xdo("keyup " + key);
+    keys_down_.erase(key);
+  }
+  // Holds `key` until `pred` holds or `seconds` pass; returns whether it held.
+  bool hold_until(const std::string& key, const std::function<bool(const json&)>& pred, double seconds,
+                  const std::function<void(const json&)>& seen = nullptr) {
+    key_down(key);
+    const bool ok = wait_for(pred, seconds, seen);
+    key_up(key);
+    return ok;
+  }
+  // A left-button drag in window pixels (from the top left), in small steps as a hand moves,
+  // ending inside the window. The pointer stays where the drag ended until the viewer has
+  // handled it (motion events read the pointer's position when they are handled).
+  void drag(int x0, int y0, int x1, int y1) {
+    x1 = std::clamp(x1, 1, width_ - 2);
+    y1 = std::clamp(y1, 1, height_ - 2);
+    xdo("mousemove --window " + window_ + " " + std::to_string(x0) + " " + std::to_string(y0));
+    xdo("mousedown 1");
+    button_down_ = true;
+    const int steps = 8;
+    for (int k = 1; k <= steps; ++k) {
+      const int x = x0 + (x1 - x0) * k / steps, y = y0 + (y1 - y0) * k / steps;
+      xdo("mousemove --window " + window_ + " " + std::to_string(x) + " " + std::to_string(y));
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    }
+    xdo("mouseup 1");
+    button_down_ = false;
+    settle();
+  }
+
+  // Presses the screenshot key and returns the image written.
+  test::Image screenshot() {
+    const int before = status().value("screenshots", 0);
+    xdo("key p");
+    EXPECT_TRUE(wait_for([&](const json& s) { return s["screenshots"].get<int>() > before; }, 10.0));
+    return test::read_png(shot_path_);
+  }
+
+  std::string stdout_text() const { return slurp(dir_.path() / "stdout"); }
+  std::string stderr_text() const { return slurp(dir_.path() / "stderr"); }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  static std::string display_tag() {
+    const char* d = std::getenv("DISPLAY");
+    std::string tag = d != nullptr ? d : "";
+    for (char& c : tag)
+      if (c == ':' || c == '/' || c == '.') c = '_';
+    return tag;
+  }
+
+  test::TempDir dir_;
+  std::filesystem::path status_path_, shot_path_;
+  pid_t pid_ = -1;
+  int lock_ = -1;
+  bool exited_ = false;
+  int exit_status_ = -1;
+  std::string window_;
+  int width_ = 0, height_ = 0;
+  std::set<std::string> keys_down_;
+  bool button_down_ = false;
+};
+
+// Common options: a 256-cell window and a small window on screen, so that each test starts in
+// about a second.
+const std::string kSmall = " --window 256 --size 800x450";
+
+struct Vec3 {
+  double x, y, z;
+};
+Vec3 eye(const json& s) {
+  const auto& e = s["camera"]["eye"];
+  return {e[0].get<double>(), e[1].get<double>(), e[2].get<double>()};
+}
+double heading(const json& s) { return s["camera"]["heading"].get<double>(); }
+double pitch(const json& s) { return s["camera"]["pitch"].get<double>(); }
+
+// Share of differing pixels (tolerance 8 per channel) in the rows [y0, y1) of two images.
+double differing_rows(const test::Image& a, const test::Image& b, int y0, int y1) {
+  std::size_t differ = 0, total = 0;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      differ += !test::same_color(a.at(x, y), b.at(x, y), 8);
+      ++total;
+    }
+  }
+  return total == 0 ? 0.0 : static_cast<double>(differ) / static_cast<double>(total);
+}
+
+TEST(ViewCli, ForwardFliesAlongTheViewAtTheHeightScaledSpeedAndBackReturns) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,30,-20" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  std::vector<json> seen;
+  ASSERT_TRUE(v.hold_until(
+      "w",
+      [&](const json& s) {
+        const Vec3 a = eye(s0), b = eye(s);
+        return std::hypot(b.x - a.x, b.y - a.y) > 600.0;
+      },
+      15.0, [&](const json& s) { seen.push_back(s); }))
+      << v.stderr_text();
+  const json s1 = v.settle();
+  const Vec3 a = eye(s0), b = eye(s1);
+  const double horizontal = std::hypot(b.x - a.x, b.y - a.y);
+  EXPECT_NEAR(std::atan2(b.x - a.x, b.y - a.y) * 180.0 / kPi, 30.0, 1.0) << "along the heading";
+  EXPECT_NEAR(std::atan2(b.z - a.z, horizontal) * 180.0 / kPi, -20.0, 1.0) << "down the view's pitch";
+  EXPECT_DOUBLE_EQ(heading(s1), 30.0);
+  EXPECT_DOUBLE_EQ(pitch(s1), -20.0);
+  // Speed: about one height above the ground per second (--speed 1), between two frames seen.
+  ASSERT_GE(seen.size(), 3u);
+  const json& f0 = seen[1];
+  const json& f1 = seen.back();
+  const Vec3 p0 = eye(f0), p1 = eye(f1);
+  const double metres = std::sqrt(std::pow(p1.x - p0.x, 2) + std::pow(p1.y - p0.y, 2) + std::pow(p1.z - p0.z, 2));
+  const double seconds = f1["time_s"].get<double>() - f0["time_s"].get<double>();
+  const double agl = 0.5 * (f0["camera"]["agl"].get<double>() + f1["camera"]["agl"].get<double>());
+  ASSERT_GT(seconds, 0.0);
+  EXPECT_GT(metres / seconds, 0.5 * agl) << metres << " m in " << seconds << " s at about " << agl << " m AGL";
+  EXPECT_LT(metres / seconds, 1.6 * agl) << metres << " m in " << seconds << " s at about " << agl << " m AGL";
+
+  // S flies back along the same line.
+  ASSERT_TRUE(v.hold_until(
+      "s",
+      [&](const json& s) {
+        const Vec3 c = eye(s);
+        return std::hypot(c.x - b.x, c.y - b.y) > 300.0;
+      },
+      15.0));
+  const Vec3 c = eye(v.settle());
+  EXPECT_NEAR(std::atan2(c.x - b.x, c.y - b.y) * 180.0 / kPi, 30.0 - 180.0, 1.0);
+  EXPECT_GT(c.z, b.z) << "backing up a downward view climbs";
+}
+
+TEST(ViewCli, ArrowKeysAndMouseDragsTurnTheView) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,30,-20" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  const test::Image before = v.screenshot();
+  ASSERT_TRUE(v.hold_until("Right", [&](const json& s) { return heading(s) > 45.0; }, 15.0));
+  json s = v.settle();
+  EXPECT_GT(heading(s), 45.0);
+  EXPECT_LT(heading(s), 120.0);
+  EXPECT_DOUBLE_EQ(pitch(s), pitch(s0));
+  const Vec3 a = eye(s0), b = eye(s);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  const test::Image turned = v.screenshot();
+  ASSERT_EQ(turned.width, before.width);
+  EXPECT_GT(test::differing_share(before, turned, 8), 0.2) << "the view should change when turning";
+
+  ASSERT_TRUE(v.hold_until("Left", [&](const json& st) { return heading(st) < 40.0; }, 15.0));
+  EXPECT_LT(heading(v.settle()), 40.0);
+
+  // Drag right 120 px and up 40 px: heading +18 degrees, pitch +6 (0.15 degree per pixel).
+  s = v.settle();
+  const int cx = v.width() / 2, cy = v.height() / 2;
+  v.drag(cx - 60, cy + 20, cx + 60, cy - 20);
+  const json d = v.settle();
+  EXPECT_NEAR(heading(d) - heading(s), 18.0, 0.5);
+  EXPECT_NEAR(pitch(d) - pitch(s), 6.0, 0.5);
+}
+
+TEST(ViewCli, DraggingTheThresholdSliderChangesTheTriangleCount) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  Viewer v(bundled_dem() + " --camera 45.3,6.3,3500,45,-15" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  ASSERT_DOUBLE_EQ(s0["threshold"].get<double>(), 2.0);
+  auto knob = [](const json& s) {
+    const json& k = s["slider"];
+    const double t = (k["value"].get<double>() - k["value_min"].get<double>()) /
+                     (k["value_max"].get<double>() - k["value_min"].get<double>());
+    const double x = k["x_min"].get<double>() + t * (k["x_max"].get<double>() - k["x_min"].get<double>());
+    return std::pair<int, int>{static_cast<int>(std::lround(x)), static_cast<int>(std::lround(k["y"].get<double>()))};
+  };
+  // Finer: drag the knob to the left end.
+  int x = 0, y = 0;
+  std::tie(x, y) = knob(s0);
+  v.drag(x, y, static_cast<int>(s0["slider"]["x_min"].get<double>()) - 40, y);
+  const json fine = v.settle();
+  EXPECT_NEAR(fine["threshold"].get<double>(), 0.25, 1e-9);
+  EXPECT_GT(fine["triangles"].get<int>(), 2 * s0["triangles"].get<int>()) << "finer threshold, more triangles";
+  // Coarser: all the way right.
+  std::tie(x, y) = knob(fine);
+  v.drag(x, y, static_cast<int>(fine["slider"]["x_max"].get<double>()) + 40, y);
+  const json coarse = v.settle();
+  EXPECT_NEAR(coarse["threshold"].get<double>(), 16.0, 1e-9);
+  EXPECT_LT(coarse["triangles"].get<int>(), s0["triangles"].get<int>()) << "coarser threshold, fewer triangles";
+  // Halfway back, by hand: a threshold in between, a triangle count in between.
+  std::tie(x, y) = knob(coarse);
+  const int mid = static_cast<int>(std::lround(0.5 * (coarse["slider"]["x_min"].get<double>() +
+                                                      coarse["slider"]["x_max"].get<double>())));
+  v.drag(x, y, mid, y);
+  const json middle = v.settle();
+  EXPECT_GT(middle["threshold"].get<double>(), 0.25);
+  EXPECT_LT(middle["threshold"].get<double>(), 16.0);
+  EXPECT_GT(middle["triangles"].get<int>(), coarse["triangles"].get<int>());
+  EXPECT_LT(middle["triangles"].get<int>(), fine["triangles"].get<int>());
+  // The keys step it too: - is coarser, + (=) finer.
+  const double t = middle["threshold"].get<double>();
+  v.tap("minus");
+  EXPECT_NEAR(v.settle()["threshold"].get<double>(), t * std::sqrt(2.0), 1e-6);
+  v.tap("equal");
+  EXPECT_NEAR(v.settle()["threshold"].get<double>(), t, 1e-6);
+}
+
+TEST(ViewCli, KeysToggleLodColoursWireframeMetricAndSlidingAndVtkDefaultsStayOff) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  Viewer v(bundled_dem() + " --camera 45.3,6.3,3500,45,-15" + kSmall);
+  ASSERT_TRUE(v.start());
+  json s = v.settle();
+  EXPECT_FALSE(s["lod_colors"].get<bool>());
+  EXPECT_FALSE(s["wireframe"].get<bool>());
+  EXPECT_EQ(s["metric"], "error");
+  EXPECT_TRUE(s["auto_slide"].get<bool>());
+  const test::Image plain = v.screenshot();
+
+  v.tap("l");
+  s = v.settle();
+  EXPECT_TRUE(s["lod_colors"].get<bool>());
+  const test::Image lod = v.screenshot();
+  EXPECT_GT(test::differing_share(plain, lod, 8), 0.3) << "LOD colours should recolour the terrain";
+
+  v.tap("t");
+  s = v.settle();
+  EXPECT_TRUE(s["wireframe"].get<bool>());
+  const test::Image wire = v.screenshot();
+  EXPECT_GT(test::differing_share(lod, wire, 8), 0.2) << "wireframe should show the sky between edges";
+
+  const int triangles = s["triangles"].get<int>();
+  v.tap("m");
+  s = v.settle();
+  EXPECT_EQ(s["metric"], "area");
+  EXPECT_DOUBLE_EQ(s["threshold"].get<double>(), 500.0);
+  EXPECT_NE(s["triangles"].get<int>(), triangles);
+  v.tap("g");
+  EXPECT_FALSE(v.settle()["auto_slide"].get<bool>());
+
+  // VTK's default bindings do nothing here: e (exit), 3 (stereo), j and u are not bound, f
+  // (VTK's fly-to) moves down, and w (VTK's wireframe) flies forward instead.
+  for (const char* key : {"e", "3", "j", "u", "f"}) {
+    v.xdo(std::string("key ") + key);
+  }
+  v.tap("t");
+  s = v.settle();
+  EXPECT_TRUE(v.running()) << "VTK's e key must not exit";
+  EXPECT_FALSE(s["wireframe"].get<bool>());
+  v.tap("w");
+  EXPECT_FALSE(v.settle()["wireframe"].get<bool>());
+
+  v.tap("l");
+  v.tap("m");
+  v.tap("g");
+  s = v.settle();
+  EXPECT_FALSE(s["lod_colors"].get<bool>());
+  EXPECT_EQ(s["metric"], "error");
+  EXPECT_TRUE(s["auto_slide"].get<bool>());
+
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+}
+
+TEST(ViewCli, FlyingTowardTheEdgeSlidesTheWindowWithoutMovingTheCamera) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  // North, level, 4 heights per second: the window's north quarter is about 6 km away.
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,0,0 --speed 4" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  ASSERT_EQ(s0["slides"], 0);
+  std::vector<json> seen;
+  ASSERT_TRUE(v.hold_until(
+      "w", [](const json& s) { return s["slides"].get<int>() >= 1; }, 20.0,
+      [&](const json& s) { seen.push_back(s); }))
+      << "no slide; last status " << v.status().dump();
+  const json s1 = v.settle();
+  // The window moved north by whole cells of the coarsest level (6 levels over 256 cells: 32
+  // cells), and the scene frame stayed.
+  const int moved = s0["window"]["row0"].get<int>() - s1["window"]["row0"].get<int>();
+  EXPECT_GT(moved, 0) << "north is toward row 0";
+  EXPECT_EQ(moved % 32, 0) << moved;
+  EXPECT_EQ(s1["window"]["col0"], s0["window"]["col0"]);
+  EXPECT_EQ(s1["window"]["origin_lat"], s0["window"]["origin_lat"]);
+  EXPECT_EQ(s1["window"]["origin_lon"], s0["window"]["origin_lon"]);
+  EXPECT_GT(s1["last_slide_ms"].get<double>(), 0.0);
+  // No jump: from frame to frame the eye moved no farther than the speed allows.
+  for (std::size_t k = 1; k < seen.size(); ++k) {
+    const Vec3 a = eye(seen[k - 1]), b = eye(seen[k]);
+    const double metres = std::sqrt(std::pow(b.x - a.x, 2) + std::pow(b.y - a.y, 2) + std::pow(b.z - a.z, 2));
+    const double dt = seen[k]["time_s"].get<double>() - seen[k - 1]["time_s"].get<double>();
+    const double speed = std::max(seen[k]["speed_mps"].get<double>(), seen[k - 1]["speed_mps"].get<double>());
+    EXPECT_LE(metres, speed * (dt + 0.3) + 1.0)
+        << "frame " << seen[k]["frame"] << " (slides " << seen[k]["slides"] << "): " << metres << " m in " << dt << " s";
+    EXPECT_NEAR(b.x, a.x, 1e-6) << "flying north: x stays";
+  }
+}
+
+TEST(ViewCli, ASlideLeavesTheViewInPlace) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  // Sliding off: fly north past the window's north quarter, look down at ground that lies in
+  // the window before and after the slide, then turn sliding on, standing still.
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,0,0 --speed 4 --no-slide" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  const double south = s0["window"]["south"].get<double>(), north = s0["window"]["north"].get<double>();
+  ASSERT_TRUE(v.hold_until(
+      "w", [&](const json& s) { return s["camera"]["lat"].get<double>() > south + 0.8 * (north - south); }, 20.0));
+  ASSERT_TRUE(v.hold_until("Down", [](const json& s) { return pitch(s) < -70.0; }, 10.0));
+  const json before = v.settle();
+  ASSERT_EQ(before["slides"], 0);
+  const test::Image a = v.screenshot();
+  v.tap("g");
+  ASSERT_TRUE(v.wait_for([](const json& s) { return s["slides"].get<int>() == 1; }, 10.0));
+  const json after = v.settle();
+  EXPECT_LT(after["window"]["row0"].get<int>(), before["window"]["row0"].get<int>());
+  for (const char* k : {"lat", "lon", "alt", "heading", "pitch"}) {
+    EXPECT_EQ(after["camera"][k], before["camera"][k]) << k;
+  }
+  EXPECT_EQ(after["camera"]["eye"], before["camera"]["eye"]);
+  EXPECT_EQ(after["triangles"], before["triangles"]) << "the same ground at the same LOD";
+  const test::Image b = v.screenshot();
+  ASSERT_EQ(a.width, b.width);
+  // Between the overlay (top) and the slider (bottom), the picture is the same.
+  const double diff = differing_rows(a, b, b.height / 5, b.height * 4 / 5);
+  EXPECT_LT(diff, 0.01) << diff * 100 << "% of the terrain's pixels differ";
+}
+
+TEST(ViewCli, EscapeQuitsWithStatusZeroAndATimingSummary) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  Viewer v(bundled_dem() + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s = v.settle();
+  EXPECT_NEAR(s["camera"]["agl"].get<double>(), 1500.0, 1e-6) << "default pose: 1500 m above the centre";
+  v.xdo("key Escape");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+  EXPECT_NE(v.stdout_text().find("frames "), std::string::npos) << v.stdout_text();
+}
+
+TEST(ViewCli, HelpListsTheKeyBindings) {
+  const auto r = test::run_terravol("view --help");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* text : {"W / S", "wireframe", "LOD colours", "sliding", "Esc", "--status", "--threshold"}) {
+    EXPECT_NE(r.out.find(text), std::string::npos) << text;
+  }
+}
+
+TEST(ViewCli, ACameraOutsideTheDemFailsWithOneLine) {
+  const auto r = test::run_terravol("view " + bundled_dem() + " --camera 47.5,6.5,4000,0,0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("terravol: camera 47.50000 N"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+}  // namespace
+}  // namespace terravol

@@ -1,0 +1,336 @@
+// The built-in propagation model: exact small cases, physics checks on synthetic terrain, and
+// seeded properties of the Deygout construction.
+#include "volume/propagation.h"
+
+#include <GeographicLib/Geodesic.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "io/mosaic.h"
+#include "volume/readers.h"
+#include "volume/vdb_write.h"
+
+namespace terravol::volume {
+namespace {
+
+constexpr double kLambda900 = 299792458.0 / 900e6;
+
+// A geographic 3" grid over 45..46 N, 6..7 E whose height is f(lat, lon).
+template <class F>
+io::Grid synthetic_dem(F f) {
+  io::Grid g;
+  g.format = "test";
+  g.allocate(1201, 1201);
+  g.georef.x0 = 6.0;
+  g.georef.y0 = 46.0;
+  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) g.heights[g.index(r, c)] = static_cast<float>(f(46.0 - r / 1200.0, 6.0 + c / 1200.0));
+  return g;
+}
+
+double geodesic_m(double lat1, double lon1, double lat2, double lon2) {
+  double s = 0.0;
+  GeographicLib::Geodesic::WGS84().Inverse(lat1, lon1, lat2, lon2, s);
+  return s;
+}
+
+// The lattice column of the transmitter.
+std::pair<int, int> tx_column(const Volume& v, const Transmitter& tx) {
+  const auto& l = v.lattice;
+  return {static_cast<int>(std::lround((tx.lon - l.origin[0]) / l.spacing[0])),
+          static_cast<int>(std::lround((tx.lat - l.origin[1]) / l.spacing[1]))};
+}
+
+TEST(FreeSpace, MatchesTheTextbookFormula) {
+  for (double f : {30.0, 144.0, 900.0, 2400.0, 10000.0}) {
+    for (double d_km : {0.1, 1.0, 7.5, 20.0, 150.0}) {
+      EXPECT_NEAR(free_space_loss_db(d_km * 1000.0, f), 32.45 + 20.0 * std::log10(f) + 20.0 * std::log10(d_km), 0.01);
+    }
+  }
+}
+
+TEST(KnifeEdge, ItuFormulaValues) {
+  EXPECT_EQ(knife_edge_loss_db(-0.78), 0.0);
+  EXPECT_EQ(knife_edge_loss_db(-3.0), 0.0);
+  EXPECT_NEAR(knife_edge_loss_db(0.0), 6.03, 0.01);   // grazing: about 6 dB
+  EXPECT_NEAR(knife_edge_loss_db(1.0), 13.93, 0.01);
+  EXPECT_NEAR(knife_edge_loss_db(-0.7), 0.53, 0.01);
+  // Large v: J(v) tends to 13 + 20 log10(v).
+  EXPECT_NEAR(knife_edge_loss_db(20.0), 13.0 + 20.0 * std::log10(20.0), 0.15);
+}
+
+TEST(Diffraction, SingleKnifeEdgeEqualsJOfV) {
+  PathProfile p;
+  p.distance_m = 10000.0;
+  p.tx_height_m = 50.0;
+  p.rx_height_m = 70.0;
+  for (double top : {20.0, 55.0, 80.0, 300.0}) {
+    p.d_m = {4000.0};
+    p.z_m = {top};
+    const double k = 4.0 / 3.0;
+    const double bulge = 4000.0 * 6000.0 / (2.0 * k * 6371000.0);
+    const double h = top + bulge - (50.0 + 20.0 * 0.4);
+    const double v = h * std::sqrt(2.0 * 10000.0 / (kLambda900 * 4000.0 * 6000.0));
+    const double expected = v > -0.78 ? 6.9 + 20.0 * std::log10(std::sqrt((v - 0.1) * (v - 0.1) + 1.0) + v - 0.1) : 0.0;
+    EXPECT_NEAR(diffraction_loss_db(p, 900.0, k), expected, 1e-9) << top;
+    EXPECT_NEAR(path_loss_db(p, 900.0, k), free_space_loss_db(std::hypot(10000.0, 20.0), 900.0) + expected, 1e-9);
+  }
+}
+
+TEST(Diffraction, ClearPathHasNone) {
+  PathProfile p;
+  p.distance_m = 20000.0;
+  p.tx_height_m = p.rx_height_m = 300.0;
+  for (int i = 1; i < 200; ++i) {
+    p.d_m.push_back(i * 100.0);
+    p.z_m.push_back(0.0);
+  }
+  EXPECT_EQ(diffraction_loss_db(p, 900.0), 0.0);
+  // With no curvature allowance the bulge of a 20 km path (about 6 m at k = 4/3) is gone;
+  // low antennas then see the ground bulge: some loss appears as k shrinks.
+  p.tx_height_m = p.rx_height_m = 8.0;
+  EXPECT_GT(diffraction_loss_db(p, 900.0, 0.5), diffraction_loss_db(p, 900.0, 4.0 / 3.0));
+}
+
+TEST(Diffraction, DeygoutPrincipalPlusSecondaryEdges) {
+  // Two equal ridges with valleys around them: the principal is one of them, the other is the
+  // secondary edge of its sub-path; the total is J(v_principal) + J(v_secondary).
+  PathProfile p;
+  p.distance_m = 12000.0;
+  p.tx_height_m = p.rx_height_m = 10.0;
+  p.d_m = {2000.0, 4000.0, 6000.0, 8000.0, 10000.0};
+  p.z_m = {0.0, 60.0, 0.0, 60.0, 0.0};
+  const double k = 1e12;  // no bulge: the geometry is exactly as written
+  const double v1 = 50.0 * std::sqrt(2.0 * 12000.0 / (kLambda900 * 4000.0 * 8000.0));
+  // Sub-path from the ridge at 4 km (the principal; the one at 8 km is its mirror image) to the
+  // receiver: the other ridge is 60 - 35 = 25 m above the line from (4000, 60) to (12000, 10).
+  const double v2 = 25.0 * std::sqrt(2.0 * 8000.0 / (kLambda900 * 4000.0 * 4000.0));
+  EXPECT_NEAR(diffraction_loss_db(p, 900.0, k, 1), knife_edge_loss_db(v1), 1e-9);
+  EXPECT_NEAR(diffraction_loss_db(p, 900.0, k, 2), knife_edge_loss_db(v1) + knife_edge_loss_db(v2), 1e-9);
+}
+
+TEST(Diffraction, SamplesJoinedToAnEdgeAreItsObstacle) {
+  // A plateau sampled every 50 m: its far samples graze the sub-path from its near edge, but
+  // they are the same obstacle, so they add nothing; a separate ridge behind a valley does.
+  PathProfile p;
+  p.distance_m = 10000.0;
+  p.tx_height_m = p.rx_height_m = 10.0;
+  for (double d = 3000.0; d <= 3500.0; d += 50.0) {
+    p.d_m.push_back(d);
+    p.z_m.push_back(100.0);
+  }
+  const double k = 1e12;
+  const double one_edge = diffraction_loss_db(p, 900.0, k, 1);
+  EXPECT_GT(one_edge, 20.0);
+  EXPECT_EQ(diffraction_loss_db(p, 900.0, k, 2), one_edge);
+  EXPECT_EQ(diffraction_loss_db(p, 900.0, k, 3), one_edge);
+  p.d_m.push_back(5000.0);  // a valley, then a second ridge
+  p.z_m.push_back(0.0);
+  p.d_m.push_back(7000.0);
+  p.z_m.push_back(80.0);
+  EXPECT_GT(diffraction_loss_db(p, 900.0, k, 2), one_edge + 5.0);
+}
+
+TEST(DiffractionProperty, SymmetricNonNegativeAndGrowingWithDepth) {
+  std::mt19937 rng(20240607);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    PathProfile p;
+    p.distance_m = 100.0 + 50000.0 * unit(rng);
+    const int n = static_cast<int>(60 * unit(rng));
+    const double relief = 1000.0 * unit(rng);
+    for (int i = 1; i <= n; ++i) {
+      p.d_m.push_back(p.distance_m * i / (n + 1));
+      p.z_m.push_back(relief * unit(rng));
+    }
+    p.tx_height_m = relief * unit(rng) + 30.0;
+    p.rx_height_m = relief * unit(rng) + 1.0;
+    const double f = 50.0 + 5000.0 * unit(rng);
+    PathProfile q;
+    q.distance_m = p.distance_m;
+    q.tx_height_m = p.rx_height_m;
+    q.rx_height_m = p.tx_height_m;
+    for (int i = n - 1; i >= 0; --i) {
+      q.d_m.push_back(p.distance_m - p.d_m[i]);
+      q.z_m.push_back(p.z_m[i]);
+    }
+    double previous = 0.0;
+    for (int depth = 1; depth <= 4; ++depth) {
+      const double forward = diffraction_loss_db(p, f, 4.0 / 3.0, depth);
+      const double backward = diffraction_loss_db(q, f, 4.0 / 3.0, depth);
+      ASSERT_TRUE(std::isfinite(forward)) << trial;
+      ASSERT_NEAR(forward, backward, 1e-7 * (1.0 + forward)) << "trial " << trial << " depth " << depth;
+      ASSERT_GE(forward, previous - 1e-12) << "trial " << trial << " depth " << depth;
+      previous = forward;
+    }
+    ASSERT_NEAR(path_loss_db(p, f), path_loss_db(q, f), 1e-7 * path_loss_db(p, f)) << trial;
+  }
+}
+
+TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
+  Transmitter tx{45.5, 6.5, 200.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 8.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {200.0};  // the transmitter's height: the path is level and clear
+  const RfResult r = compute_rf(flat, tx, grid);
+  const Volume& v = r.path_loss;
+  const auto [it, jt] = tx_column(v, tx);
+  int checked = 0;
+  for (int j = 0; j < v.lattice.dims[1]; ++j) {
+    for (int i = 0; i < v.lattice.dims[0]; ++i) {
+      if (i == it && j == jt) continue;
+      const double d_km = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, j), v.lattice.world(0, i)) / 1000.0;
+      EXPECT_NEAR(v.at(i, j, 0), 32.45 + 20.0 * std::log10(900.0) + 20.0 * std::log10(d_km), 0.01) << i << " " << j;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 400);
+  EXPECT_NEAR(v.at(it, jt, 0), free_space_loss_db(1.0, 900.0), 1e-4);  // same point: clamped to 1 m
+}
+
+TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 25.0;
+  grid.spacing_arcsec = 15.0;
+  grid.heights_agl = {2.0, 52.0, 102.0};
+  const Volume v = compute_rf(flat, tx, grid).path_loss;
+  const auto [it, jt] = tx_column(v, tx);
+  for (int k = 0; k < 3; ++k) {
+    for (int i = it + 1; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
+    for (int i = it - 1; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
+    for (int j = jt + 1; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
+  }
+  // Beyond the radio horizon of 30 m and 2 m antennas (about 28 km at k = 4/3), the bulge
+  // diffracts: the far corner at 2 m is well below free space... and higher receivers see more.
+  const int far = v.lattice.dims[0] - 1;
+  const double d = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
+  EXPECT_GT(v.at(far, 0, 0), free_space_loss_db(d, 900.0) + 6.0);
+  EXPECT_LT(v.at(far, 0, 2), v.at(far, 0, 0));
+}
+
+TEST(Rf, LossGrowsBehindARidge) {
+  // A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of the transmitter.
+  const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 12.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {10.0, 210.0, 410.0, 610.0, 810.0};
+  const Volume v = compute_rf(dem, tx, grid).path_loss;
+  const auto [it, jt] = tx_column(v, tx);
+  const int east = v.lattice.dims[0] - 1, west = 0;
+  ASSERT_GT(v.lattice.world(0, east), 6.6);
+  const double d_east = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, east));
+  const double d_west = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, west));
+  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);  // deep shadow
+  // The open side: the bulge of flat ground leaves about half a Fresnel zone of clearance at
+  // 12 km for 30 m and 10 m antennas, so the loss is close to free space.
+  EXPECT_NEAR(v.at(west, jt, 0), free_space_loss_db(std::hypot(d_west, 20.0), 900.0), 2.0);
+  // Behind the ridge the loss falls as the receiver rises out of the shadow.
+  for (int k = 1; k < 5; ++k) EXPECT_LT(v.at(east, jt, k), v.at(east, jt, k - 1)) << k;
+  // Every column east of the ridge at 10 m is in its shadow.
+  for (int i = it; i < v.lattice.dims[0]; ++i) {
+    if (v.lattice.world(0, i) <= 6.565) continue;
+    const double d = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, i));
+    EXPECT_GT(v.at(i, jt, 0), free_space_loss_db(d, 900.0) + 15.0) << i;
+  }
+}
+
+TEST(Rf, SignalIsEirpMinusPathLoss) {
+  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 500.0 + 300.0 * std::sin(40.0 * lat) * std::cos(50.0 * lon); });
+  const Transmitter tx{45.5, 6.5, 30.0, 450.0, 50.0};
+  RfGrid grid;
+  grid.radius_km = 5.0;
+  grid.spacing_arcsec = 20.0;
+  grid.heights_agl = {0.0, 100.0};
+  const RfResult r = compute_rf(dem, tx, grid);
+  ASSERT_TRUE(r.signal);
+  EXPECT_EQ(r.signal->name, "signal_dbm");
+  EXPECT_EQ(r.signal->units, "dBm");
+  EXPECT_EQ(r.signal->lattice, r.path_loss.lattice);
+  const double eirp = 10.0 * std::log10(50.0) + 30.0 + 2.15;  // 50 W ERP = 46.99 dBm, + 2.15 dB dipole gain
+  for (std::size_t n = 0; n < r.path_loss.values.size(); ++n) {
+    EXPECT_NEAR(r.signal->values[n], eirp - r.path_loss.values[n], 1e-4);
+  }
+  EXPECT_FALSE(compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 450.0, std::nullopt}, grid).signal);
+}
+
+TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
+  const Transmitter centre{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 20.0;
+  grid.heights_agl = {};
+  const RfResult r = compute_rf(flat, centre, grid);
+  const Lattice& l = r.path_loss.lattice;
+  EXPECT_EQ(l.spacing[0], 6.0 / 3600.0);  // default spacing: 2 x 3" for a 20 km radius
+  EXPECT_EQ(l.dims[2], 41);                // default heights 0, 50, ..., 2000
+  EXPECT_EQ(l.world(2, 40), 2000.0);
+  EXPECT_EQ(l.dims[0] % 2, 1);
+  EXPECT_EQ(l.dims[1] % 2, 1);
+  EXPECT_NEAR(l.world(0, l.dims[0] / 2), 6.5, 1e-12);
+  EXPECT_NEAR(l.world(1, l.dims[1] / 2), 45.5, 1e-12);
+  EXPECT_NEAR((l.world(1, l.dims[1] - 1) - 45.5) * 111132.0, 20000.0, 200.0);
+  EXPECT_TRUE(r.notes.empty());
+  EXPECT_EQ(r.path_loss.frame, parse_frame("geographic-agl"));
+
+  const Transmitter corner{45.05, 6.03, 10.0, 900.0, std::nullopt};
+  const RfResult c = compute_rf(flat, corner, grid);
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_GE(c.path_loss.lattice.origin[0], 6.0);
+  EXPECT_GE(c.path_loss.lattice.origin[1], 45.0);
+  const auto [i, j] = tx_column(c.path_loss, corner);
+  EXPECT_NEAR(c.path_loss.lattice.world(0, i), corner.lon, 1e-12);
+  EXPECT_NEAR(c.path_loss.lattice.world(1, j), corner.lat, 1e-12);
+}
+
+TEST(Rf, RejectsBadParameters) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
+  const Transmitter tx{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 0.0;
+  EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
+  grid.radius_km = 5.0;
+  grid.heights_agl = {10.0, 20.0, 40.0};
+  EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
+  grid.heights_agl = {10.0};
+  EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0}, grid), std::invalid_argument);
+}
+
+TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
+  const auto dem = std::filesystem::path(TERRAVOL_SOURCE_DIR) / "data" / "dem" / "N45E006.hgt";
+  const io::Mosaic mosaic = io::Mosaic::open({dem});
+  RfGrid grid;
+  grid.radius_km = 3.0;
+  grid.spacing_arcsec = 15.0;
+  grid.heights_agl = {0.0, 100.0, 200.0};
+  const RfResult r = compute_rf(mosaic, Transmitter{45.5, 6.5, 30.0, 900.0, 50.0}, grid);
+  EXPECT_EQ(r.path_loss.attributes.at("dem"), "N45E006.hgt");
+  EXPECT_EQ(r.path_loss.attributes.at("tx_lat"), "45.5");
+  const std::string bytes = encode_vdb({&r.path_loss, &*r.signal});
+  const Volume loss = parse_vdb(bytes, "rf.vdb");
+  EXPECT_EQ(loss.name, "path_loss_db");
+  EXPECT_EQ(loss.values, r.path_loss.values);
+  EXPECT_EQ(loss.lattice, r.path_loss.lattice);
+  EXPECT_EQ(loss.frame, r.path_loss.frame);
+  EXPECT_EQ(loss.attributes, r.path_loss.attributes);
+  ReadOptions o;
+  o.field = "signal_dbm";
+  const Volume signal = parse_vdb(bytes, "rf.vdb", o);
+  EXPECT_EQ(signal.values, r.signal->values);
+  EXPECT_EQ(signal.units, "dBm");
+}
+
+}  // namespace
+}  // namespace terravol::volume
