@@ -44,17 +44,6 @@ std::string degrees(double v, char positive, char negative) {
   return b;
 }
 
-// The farthest any window sample can be from the eye, with a margin: the far clipping plane.
-double far_plane_for(const TerrainScene& scene, const glm::dvec3& eye) {
-  double far = 0.0;
-  const auto xs = scene.xs(), ys = scene.ys();
-  for (double x : {xs.front(), xs.back()})
-    for (double y : {ys.front(), ys.back()})
-      for (double z : {static_cast<double>(scene.min_z()), static_cast<double>(scene.max_z())})
-        far = std::max(far, glm::length(glm::dvec3(x, y, z) - eye));
-  return far * 1.05 + 100.0;
-}
-
 void run_render(const RenderOptions& o) {
   // Fail before the expensive work when an output would be replaced or nothing can be drawn.
   for (const auto* p : {&o.output, &o.stats, &o.export_vtp}) {
@@ -95,7 +84,7 @@ void run_render(const RenderOptions& o) {
   }
   const mrbsp::Camera camera = make_scene_camera(scene.frame(), o.pose, eye_height, o.fov_y_deg, o.render.width,
                                                  o.render.height, near_plane_for(clearance));
-  const double far = far_plane_for(scene, camera.eye);
+  const double far = scene.far_plane(camera.eye);
   RenderSettings settings = o.render;
   if (settings.gradient) {
     const auto sky = sky_gradient(o.pose.pitch_deg, o.fov_y_deg);
