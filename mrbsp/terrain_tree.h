@@ -103,7 +103,9 @@ class TerrainTree {
   // then per sample the bottom of skirts under edges along its row ((n+1)^2 + v), then the
   // bottom of skirts under edges along its column (2 (n+1)^2 + v). A bottom lies 1 m below
   // the lowest sample of its lattice line within the level-0 cell edges through the sample,
-  // hence below every level's surface along those edges. Stable until slide().
+  // hence below every level's surface along those edges. Merged vertices follow, from
+  // merged_base(). The terrain blocks change only in slide(); merge() and slide() replace the
+  // merged vertices.
   const std::vector<glm::vec3>& positions() const;
 
   // Emits the triangles of the view into `frame` (cleared first; its capacity is reused, so
