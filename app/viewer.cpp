@@ -605,7 +605,7 @@ void Viewer::start_slide() {
   double row = 0, col = 0;
   lattice_position(mosaic_, pose_.lat, pose_.lon, row, col);
   const WindowChoice& now = scene_->window();
-  const int step = now.cells >> (scene_->tree().levels() - 1);  // one coarsest-level cell
+  const int step = 1 << (scene_->tree().levels() - 1);  // samples across one coarsest-level cell
   const WindowChoice next = plan_slide(now, mosaic_.rows(), mosaic_.cols(), row, col, step);
   if (next.row0 == now.row0 && next.col0 == now.col0) return;
   const mrbsp::TerrainTree& tree = scene_->tree();

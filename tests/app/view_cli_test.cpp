@@ -493,8 +493,9 @@ TEST(ViewCli, KeysToggleLodColoursWireframeMetricAndSlidingAndVtkDefaultsStayOff
 
 TEST(ViewCli, FlyingTowardTheEdgeSlidesTheWindowWithoutMovingTheCamera) {
   TERRAVOL_REQUIRE_XDOTOOL();
-  // North, level, 4 heights per second: the window's north quarter is about 6 km away.
-  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,0,0 --speed 4" + kSmall);
+  // North, level, 1 height per second: the window's north quarter is about 6 km away, the
+  // DEM's north edge 55 km.
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,0,0 --speed 1" + kSmall);
   ASSERT_TRUE(v.start());
   const json s0 = v.settle();
   ASSERT_EQ(s0["slides"], 0);
@@ -504,8 +505,8 @@ TEST(ViewCli, FlyingTowardTheEdgeSlidesTheWindowWithoutMovingTheCamera) {
       [&](const json& s) { seen.push_back(s); }))
       << "no slide; last status " << v.status().dump();
   const json s1 = v.settle();
-  // The window moved north by whole cells of the coarsest level (6 levels over 256 cells: 32
-  // cells), and the scene frame stayed.
+  // The window moved north by whole cells of the coarsest level (6 levels over 256 cells: a
+  // coarsest cell is 32 samples wide), and the scene frame stayed.
   const int moved = s0["window"]["row0"].get<int>() - s1["window"]["row0"].get<int>();
   EXPECT_GT(moved, 0) << "north is toward row 0";
   EXPECT_EQ(moved % 32, 0) << moved;
