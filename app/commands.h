@@ -12,5 +12,8 @@ void add_sample_dem_command(CLI::App& app);  // terravol sample-dem -o DIR
 void add_render_command(CLI::App& app);      // terravol render DEM... --camera ... -o PNG
 void add_view_command(CLI::App& app);        // terravol view DEM... (interactive)
 void add_rf_command(CLI::App& app);          // terravol rf --tx ... --dem DEM... -o out.vdb
+void add_fly_command(CLI::App& app);         // terravol fly PATH.json -o out.mp4|frames/
+void add_splat_command(CLI::App& app);       // terravol splat-volume --tx ... --sdf DIR -o out.vdb
+void add_compare_command(CLI::App& app);     // terravol compare-volumes A.vdb B.vdb
 
 }  // namespace terravol::app

@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
   terravol::app::add_render_command(app);
   terravol::app::add_view_command(app);
   terravol::app::add_rf_command(app);
+  terravol::app::add_fly_command(app);
+  terravol::app::add_splat_command(app);
+  terravol::app::add_compare_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,6 +13,10 @@ namespace terravol::app {
 // (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.
 std::vector<std::uint8_t> window_png(vtkRenderWindow* window);
 
+// The same frame as raw RGB bytes, width * height * 3, top row first (what a video encoder
+// takes).
+std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window);
+
 // Writes PNG bytes to `path` through a temporary file in the same folder and a rename, so a
 // reader never sees half an image. Throws std::runtime_error ("PATH: exists (use --force to
 // overwrite)") when path exists and !overwrite, and on I/O errors (write_file_atomically).

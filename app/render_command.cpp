@@ -19,6 +19,8 @@
 #include "app/camera.h"
 #include "app/commands.h"
 #include "app/png_output.h"
+#include "app/scene_file.h"
+#include "app/scene_renderer.h"
 #include "app/render_options.h"
 #include "app/terrain_colors.h"
 #include "app/terrain_renderer.h"
@@ -38,12 +40,6 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-std::string degrees(double v, char positive, char negative) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4f %c", std::abs(v), v < 0 ? negative : positive);
-  return b;
-}
-
 void run_render(const RenderOptions& o) {
   // Fail before the expensive work when an output would be replaced or nothing can be drawn.
   for (const auto* p : {&o.output, &o.stats, &o.export_vtp}) {
@@ -52,39 +48,6 @@ void run_render(const RenderOptions& o) {
     }
   }
   const auto t_start = Clock::now();
-
-  // The mosaic and the window around the camera.
-  const io::Mosaic mosaic = io::Mosaic::open(o.dems);
-  const io::Georef& g = mosaic.georef();
-  const double row = (g.y0 - o.pose.lat) / g.dy;
-  const double col = (std::remainder(o.pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-  if (row < 0 || row > mosaic.rows() - 1 || col < 0 || col > mosaic.cols() - 1) {
-    const double south = g.y0 - (mosaic.rows() - 1) * g.dy, east = g.x0 + (mosaic.cols() - 1) * g.dx;
-    throw std::runtime_error("camera " + degrees(o.pose.lat, 'N', 'S') + ", " + degrees(o.pose.lon, 'E', 'W') +
-                             " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
-                             ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
-  }
-  require_x_display();
-  const WindowChoice window = choose_window(mosaic.rows(), mosaic.cols(), row, col, o.max_window);
-  const int levels = o.levels > 0 ? o.levels : default_levels(window.cells);
-  const auto t_read = Clock::now();
-  const TerrainScene scene(mosaic, window, levels);
-  const double scene_ms = ms_since(t_read);
-  const mrbsp::TerrainTree& tree = scene.tree();
-
-  // The camera.
-  const double ground = scene.ground_height(o.pose.lat, o.pose.lon);
-  const double eye_height = o.agl ? ground + o.pose.alt : o.pose.alt;
-  const double clearance = eye_height - ground;
-  if (clearance <= 0.0) {
-    char b[160];
-    std::snprintf(b, sizeof b, "camera at %.1f m is not above the ground (%.1f m there)%s", eye_height, ground,
-                  o.agl ? "" : "; use --agl for heights above ground");
-    throw std::runtime_error(b);
-  }
-  const mrbsp::Camera camera = make_scene_camera(scene.frame(), o.pose, eye_height, o.fov_y_deg, o.render.width,
-                                                 o.render.height, near_plane_for(clearance));
-  const double far = scene.far_plane(camera.eye);
   RenderSettings settings = o.render;
   if (settings.gradient) {
     const auto sky = sky_gradient(o.pose.pitch_deg, o.fov_y_deg);
@@ -97,78 +60,80 @@ void run_render(const RenderOptions& o) {
   // Haze is for pictures; the LOD colours are a diagnostic and stay exact.
   settings.haze_distance = settings.lod_colors ? 0.0 : o.haze_km * 1000.0;
 
-  // Colours, the VTK scene, and two frames: the first pays for the upload of the vertices and
-  // the shaders; the second is what every later frame of a flythrough costs.
-  const auto t_shade = Clock::now();
-  const TerrainShading lattice =
-      shade_terrain(scene.cells(), scene.xs(), scene.ys(), scene.z(), scene.heights(), o.shading);
-  const TerrainShading shading = vertex_shading(lattice, tree.merged_base(), tree.merged_colors());
-  const double shade_ms = ms_since(t_shade);
-  TerrainRenderer renderer(tree.positions(), shading, settings, ColorTexture{scene.cells() + 1, lattice.rgba});
-  renderer.set_camera(camera, far);
+  SceneSpec scene;
+  scene.dems = o.dems;
+  scene.volumes = o.volumes;
+  scene.camera = SceneCamera{o.pose, o.agl, o.fov_y_deg};
+  const auto t_scene = Clock::now();
+  SceneRenderer view(scene, settings, o.max_window, o.levels, o.shading, o.legend, o.surface_triangles);
+  const double scene_ms = ms_since(t_scene);
 
-  mrbsp::Frame frame;
-  auto t0 = Clock::now();
-  tree.traverse(camera, o.traversal, frame);
-  const double first_traversal_ms = ms_since(t0);
-  renderer.set_frame(frame);
-  const double first_draw_ms = renderer.render();
+  // Two frames: the first pays for the upload of the vertices and the shaders; the second is
+  // what every later frame of a flythrough costs.
+  const FrameStats first = view.render(o.pose, o.agl, o.fov_y_deg, o.traversal);
+  const FrameStats f = view.render(o.pose, o.agl, o.fov_y_deg, o.traversal);
 
-  t0 = Clock::now();
-  tree.traverse(camera, o.traversal, frame);
-  const double traversal_ms = ms_since(t0);
-  t0 = Clock::now();
-  renderer.set_frame(frame);
-  const double upload_ms = ms_since(t0);
-  const double draw_ms = renderer.render();
-
-  write_png(o.output, renderer.png(), o.force);
+  write_png(o.output, view.png(), o.force);
   std::printf("wrote %s\n", o.output.string().c_str());
-
-  const std::size_t triangles = frame.indices.size() / 3;
+  const MergeFigures& merge = view.merge_figures();
+  if (view.volume_count() > 0) {
+    std::printf("volumes: %zu triangles extracted in %.0f ms, %zu in the tree after a %.0f ms merge; %zu of %zu drawn\n",
+                merge.input_triangles, merge.geometry_ms, merge.tree_triangles, merge.merge_ms, f.merged_triangles,
+                f.triangles);
+  }
   if (!o.export_vtp.empty()) {
-    export_vtp(o.export_vtp, renderer.scene(), renderer.camera(), settings, o.force);
+    TerrainRenderer& r = view.renderer();
+    export_vtp(o.export_vtp, r.scene(), r.camera(), r.settings(), o.force);
     std::printf("wrote %s\n", o.export_vtp.string().c_str());
   }
   if (!o.stats.empty()) {
-    const WindowBounds b = scene.bounds();
+    const TerrainScene& terrain = view.terrain();
+    const mrbsp::TerrainTree& tree = terrain.tree();
+    const WindowChoice& window = terrain.window();
+    const WindowBounds b = terrain.bounds();
+    const mrbsp::Camera& camera = view.camera();
     ordered_json j;
     j["output"] = o.output.string();
     j["width"] = o.render.width;
     j["height"] = o.render.height;
-    j["order"] = o.render.order == DrawOrder::kBsp ? "bsp" : "zbuffer";
+    j["order"] = order_name(o.render.order);
     j["lod_metric"] = o.traversal.metric == mrbsp::LodMetric::kError ? "error" : "area";
     j["threshold_px"] = o.traversal.threshold_px;
     j["full_res"] = o.traversal.full_res;
     j["window"] = {{"cells", window.cells},   {"row0", window.row0},   {"col0", window.col0},
                    {"south", b.south},        {"north", b.north},      {"west", b.west},
-                   {"east", b.east},          {"origin_lat", scene.frame().lat0()},
-                   {"origin_lon", scene.frame().lon0()}, {"filled_samples", scene.filled_samples()}};
+                   {"east", b.east},          {"origin_lat", terrain.frame().lat0()},
+                   {"origin_lon", terrain.frame().lon0()}, {"filled_samples", terrain.filled_samples()}};
     j["levels"] = tree.levels();
     j["vertices"] = tree.positions().size();
-    j["triangles"] = triangles;
-    j["skirt_triangles"] = frame.skirt_triangles;
-    j["nodes_visited"] = frame.nodes_visited;
-    j["leaves"] = frame.leaves;
-    j["lod_histogram"] = frame.lod_histogram;
+    j["triangles"] = f.triangles;
+    j["merged_triangles"] = f.merged_triangles;
+    j["skirt_triangles"] = view.last_frame().skirt_triangles;
+    j["nodes_visited"] = f.nodes_visited;
+    j["leaves"] = view.last_frame().leaves;
+    j["lod_histogram"] = view.last_frame().lod_histogram;
+    j["volumes"] = {{"count", view.volume_count()},
+                    {"input_triangles", merge.input_triangles},
+                    {"tree_triangles", merge.tree_triangles},
+                    {"geometry_ms", merge.geometry_ms},
+                    {"merge_ms", merge.merge_ms}};
     j["camera"] = {{"lat", o.pose.lat},
                    {"lon", o.pose.lon},
-                   {"eye_height", eye_height},
-                   {"ground_height", ground},
+                   {"eye_height", f.eye_height},
+                   {"ground_height", f.ground_height},
                    {"heading", o.pose.heading_deg},
                    {"pitch", o.pose.pitch_deg},
                    {"fov_y", o.fov_y_deg},
                    {"eye", {camera.eye.x, camera.eye.y, camera.eye.z}},
                    {"near", camera.near_plane},
-                   {"far", far}};
-    j["build_ms"] = scene.build_ms();
-    j["scene_ms"] = scene_ms;  // read, fill, frame and build
-    j["shade_ms"] = shade_ms;
-    j["first_traversal_ms"] = first_traversal_ms;
-    j["first_draw_ms"] = first_draw_ms;
-    j["traversal_ms"] = traversal_ms;
-    j["upload_ms"] = upload_ms;
-    j["draw_ms"] = draw_ms;
+                   {"far", terrain.far_plane(camera.eye)}};
+    j["build_ms"] = terrain.build_ms();
+    j["scene_ms"] = scene_ms;  // read, fill, frame, build, volumes, merge, renderer
+    j["first_traversal_ms"] = first.traversal_ms;
+    j["first_draw_ms"] = first.draw_ms;
+    j["traversal_ms"] = f.traversal_ms;
+    j["upload_ms"] = f.upload_ms;
+    j["draw_ms"] = f.draw_ms;
     j["total_ms"] = ms_since(t_start);
     const std::string text = j.dump(2) + "\n";
     write_file_atomically(o.stats, std::vector<std::uint8_t>(text.begin(), text.end()), o.force);
@@ -179,49 +144,100 @@ void run_render(const RenderOptions& o) {
 }  // namespace
 
 void add_render_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("render", "Render the terrain of DEM files to a PNG image (needs an X display)");
+  auto* cmd = app.add_subcommand("render", "Render the terrain of DEM files, and RF volumes over it, to a PNG image "
+                                           "(needs an X display)");
   struct Raw {
     RenderOptions o;
     std::string camera, size = "1280x720", metric = "error", order = "bsp", background, tint = "atlas";
     double threshold = 0.0;  // when --threshold is not given: the metric's default
+    std::filesystem::path scene;
+    std::vector<std::filesystem::path> volumes;
+    std::vector<std::string> isos, slices;
+    std::string volume_frame, field;
+    bool no_legend = false;
   };
   auto raw = std::make_shared<Raw>();
   RenderOptions& o = raw->o;
-  cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic)")->required();
-  cmd->add_option("--camera", raw->camera,
+  cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic); default: the scene file's");
+  cmd->add_option("--scene", raw->scene,
+                  "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
+  auto* camera = cmd->add_option("--camera", raw->camera,
                   "LAT,LON,ALT,HEADING,PITCH: degrees, metres (in the DEM's datum; above ground with --agl), "
-                  "heading clockwise from north, pitch above the horizon")
-      ->required();
+                  "heading clockwise from north, pitch above the horizon");
   cmd->add_option("-o,--output", o.output, "PNG file to write")->required();
-  cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
-  cmd->add_option("--size", raw->size, "Image size WIDTHxHEIGHT, pixels")->capture_default_str();
-  cmd->add_option("--lod-metric", raw->metric, "LOD metric: error (screen-space error) or area (the paper's)")
+  auto* fov = cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
+  auto* size = cmd->add_option("--size", raw->size, "Image size WIDTHxHEIGHT, pixels")->capture_default_str();
+  auto* metric = cmd->add_option("--lod-metric", raw->metric, "LOD metric: error (screen-space error) or area (the paper's)")
       ->capture_default_str();
   auto* threshold = cmd->add_option("--threshold", raw->threshold,
                   "LOD threshold: pixels of screen-space error (default 2) or, with --lod-metric area, "
                   "projected box area in square pixels (default 500)");
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
-  cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
+  auto* window = cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
   cmd->add_option("--background", raw->background, "Uniform background R,G,B (0-255) instead of the sky");
   cmd->add_flag("--wireframe", o.render.wireframe, "Draw triangle edges only");
   cmd->add_flag("--lod-colors", o.render.lod_colors, "Colour each LOD level (skirts grey)");
   cmd->add_flag("--full-res", o.traversal.full_res, "Every region at full resolution");
-  cmd->add_option("--order", raw->order, "bsp (tree order, no depth test) or zbuffer (the reference)")
+  auto* order = cmd->add_option("--order", raw->order,
+                  "bsp (tree order, no depth test), zbuffer (the same order, depth-tested), and for translucent "
+                  "volumes the references: peel (VTK depth peeling, unlimited peels: exact), vtk (VTK's default "
+                  "alpha blending, unsorted), sort (vtkDepthSortPolyData)")
       ->capture_default_str();
   cmd->add_flag("--agl", o.agl, "ALT is metres above the ground under the camera");
   cmd->add_flag("--force", o.force, "Replace existing output files");
   cmd->add_option("--stats", o.stats, "Write figures of the render (JSON)");
   cmd->add_option("--export-vtp", o.export_vtp, "Write the triangles drawn, in draw order (VTK XML PolyData)");
-  cmd->add_option("--sun-azimuth", o.shading.sun_azimuth_deg, "Sun direction, degrees clockwise from north")
+  auto* sun_azimuth = cmd->add_option("--sun-azimuth", o.shading.sun_azimuth_deg, "Sun direction, degrees clockwise from north")
       ->capture_default_str();
-  cmd->add_option("--sun-elevation", o.shading.sun_elevation_deg, "Sun elevation, degrees")->capture_default_str();
-  cmd->add_option("--haze", o.haze_km, "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; 0: none")
+  auto* sun_elevation = cmd->add_option("--sun-elevation", o.shading.sun_elevation_deg, "Sun elevation, degrees")->capture_default_str();
+  auto* haze = cmd->add_option("--haze", o.haze_km, "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; 0: none")
       ->capture_default_str();
-  cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
+  auto* tint = cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
       ->capture_default_str();
-  cmd->callback([raw, levels, threshold] {
+  cmd->add_option("--volume", raw->volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
+  cmd->add_option("--field", raw->field, "The --volume files' grid or array (default: the first)");
+  cmd->add_option("--volume-frame", raw->volume_frame,
+                  "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
+  cmd->add_option("--iso", raw->isos,
+                  "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume (of the scene file's volumes when "
+                  "no --volume is given); repeatable");
+  cmd->add_option("--slice", raw->slices,
+                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
+                  "repeatable");
+  auto* legend = cmd->add_flag("--no-legend", raw->no_legend, "No colour legend for the volumes");
+  auto* surface = cmd->add_option("--surface-triangles", o.surface_triangles,
+                  "Decimate each isosurface and slice to at most this many triangles before merging (0: keep all)")
+      ->capture_default_str();
+  cmd->callback([=] {
     RenderOptions& opt = raw->o;
-    opt.pose = parse_camera_pose(raw->camera);
+    // The scene file first; whatever the command line gave wins.
+    SceneSpec file;
+    if (!raw->scene.empty()) file = load_scene_file(raw->scene);
+    const SceneStyle& st = file.style;
+    if (opt.dems.empty()) opt.dems = file.dems;
+    if (opt.dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
+    if (camera->count() > 0) {
+      opt.pose = parse_camera_pose(raw->camera);
+    } else if (file.camera) {
+      opt.pose = file.camera->pose;
+      opt.agl = opt.agl || file.camera->agl;
+      if (fov->count() == 0) opt.fov_y_deg = file.camera->fov_y_deg;
+    } else {
+      throw std::invalid_argument("--camera is required (or a \"camera\" in the scene file)");
+    }
+    if (size->count() == 0 && st.width) raw->size = std::to_string(*st.width) + "x" + std::to_string(*st.height);
+    if (metric->count() == 0 && st.lod_metric) raw->metric = *st.lod_metric;
+    if (order->count() == 0 && st.order) raw->order = *st.order;
+    if (tint->count() == 0 && st.tint) raw->tint = *st.tint;
+    if (threshold->count() == 0 && st.threshold) raw->threshold = *st.threshold;
+    if (window->count() == 0 && st.window) opt.max_window = *st.window;
+    if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
+    if (sun_azimuth->count() == 0 && st.sun_azimuth) opt.shading.sun_azimuth_deg = *st.sun_azimuth;
+    if (sun_elevation->count() == 0 && st.sun_elevation) opt.shading.sun_elevation_deg = *st.sun_elevation;
+    opt.legend = legend->count() == 0 ? st.legend.value_or(true) : false;
+    if (surface->count() == 0 && st.surface_triangles) opt.surface_triangles = *st.surface_triangles;
+    opt.volumes = volumes_from_options(file.volumes, raw->volumes, raw->field, raw->volume_frame, raw->isos, raw->slices);
+
     parse_size(raw->size, opt.render.width, opt.render.height);
     opt.traversal.metric = parse_metric(raw->metric);
     opt.render.order = parse_order(raw->order);
@@ -230,7 +246,7 @@ void add_render_command(CLI::App& app) {
       opt.render.background = parse_rgb("--background", raw->background);
       opt.render.gradient = false;
     }
-    if (threshold->count() == 0) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
+    if (threshold->count() == 0 && !st.threshold) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
     if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
       throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
     }

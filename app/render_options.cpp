@@ -59,7 +59,55 @@ mrbsp::LodMetric parse_metric(std::string_view text) {
 DrawOrder parse_order(std::string_view text) {
   if (text == "bsp") return DrawOrder::kBsp;
   if (text == "zbuffer") return DrawOrder::kZBuffer;
-  throw std::invalid_argument(quote("--order", text) + "unknown order (expected bsp or zbuffer)");
+  if (text == "peel") return DrawOrder::kPeel;
+  if (text == "vtk") return DrawOrder::kVtk;
+  if (text == "sort") return DrawOrder::kSort;
+  throw std::invalid_argument(quote("--order", text) + "unknown order (expected bsp, zbuffer, peel, vtk or sort)");
+}
+
+const char* order_name(DrawOrder order) {
+  switch (order) {
+    case DrawOrder::kBsp: return "bsp";
+    case DrawOrder::kZBuffer: return "zbuffer";
+    case DrawOrder::kPeel: return "peel";
+    case DrawOrder::kVtk: return "vtk";
+    case DrawOrder::kSort: return "sort";
+  }
+  return "?";
+}
+
+std::vector<VolumeSpec> volumes_from_options(std::vector<VolumeSpec> from_file,
+                                             const std::vector<std::filesystem::path>& files, const std::string& field,
+                                             const std::string& frame, const std::vector<std::string>& isos,
+                                             const std::vector<std::string>& slices) {
+  if (!frame.empty()) {
+    try {
+      volume::parse_frame(frame);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(quote("--volume-frame", frame) + e.what());
+    }
+  }
+  std::vector<volume::IsoSpec> iso_specs;
+  for (std::size_t k = 0; k < isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(isos[k], k));
+  std::vector<volume::SliceSpec> slice_specs;
+  for (const auto& text : slices) slice_specs.push_back(volume::parse_slice(text));
+  if (files.empty()) {
+    for (VolumeSpec& v : from_file) {
+      if (!iso_specs.empty()) v.isosurfaces = iso_specs;
+      if (!slice_specs.empty()) v.slices = slice_specs;
+    }
+    return from_file;
+  }
+  for (const auto& f : files) {
+    VolumeSpec v;
+    v.file = f;
+    v.field = field;
+    v.frame = frame;
+    v.isosurfaces = iso_specs;
+    v.slices = slice_specs;
+    from_file.push_back(std::move(v));
+  }
+  return from_file;
 }
 
 Tint parse_tint(std::string_view text) {

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "app/camera.h"
+#include "app/scene_file.h"
+#include "app/volume_layer.h"
 #include "app/terrain_colors.h"
 #include "app/terrain_renderer.h"
 #include "mrbsp/terrain_tree.h"
@@ -29,14 +31,27 @@ struct RenderOptions {
   bool force = false;              // replace existing outputs
   std::filesystem::path stats;     // JSON, optional
   std::filesystem::path export_vtp;  // optional
+  std::vector<VolumeSpec> volumes;   // RF volumes and their styles
+  bool legend = true;                // a colour legend when volumes are drawn
+  std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
 };
+
+// The volumes of a render from the scene file's and the command line's: each --volume FILE
+// (read as `field`, placed by `frame` when not empty) gets the --iso and --slice styles; when
+// no --volume is given, non-empty --iso or --slice lists replace the styles of every volume of
+// the scene file. Throws std::invalid_argument for bad --iso, --slice or --volume-frame text.
+std::vector<VolumeSpec> volumes_from_options(std::vector<VolumeSpec> from_file,
+                                             const std::vector<std::filesystem::path>& files, const std::string& field,
+                                             const std::string& frame, const std::vector<std::string>& isos,
+                                             const std::vector<std::string>& slices);
 
 // "WxH", each 1..16384.
 void parse_size(std::string_view text, int& width, int& height);
 // "R,G,B", each 0..255.
 Rgb parse_rgb(std::string_view option, std::string_view text);
 mrbsp::LodMetric parse_metric(std::string_view text);  // error | area
-DrawOrder parse_order(std::string_view text);          // bsp | zbuffer
+DrawOrder parse_order(std::string_view text);          // bsp | zbuffer | peel | vtk | sort
+const char* order_name(DrawOrder order);               // the inverse of parse_order
 Tint parse_tint(std::string_view text);                // atlas | relative | grey
 
 }  // namespace terravol::app

@@ -170,7 +170,7 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   out.normals.resize(total);
   out.shade.resize(total);
   out.rgba.resize(total);
-  out.tcoords.resize(total, glm::vec2(0.0f));
+  out.tcoords.resize(total, glm::vec2(-1.0f));
   for (std::size_t v = 0; v < terrain_vertices; ++v) {
     const std::size_t t = v % samples;
     out.normals[v] = lattice.normals[t];

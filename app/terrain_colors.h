@@ -53,7 +53,8 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
 // `terrain_vertices` (TerrainTree::merged_base()) is a lattice sample or a skirt bottom hanging
 // under sample v % (n+1)^2, and copies that sample's attributes (so a skirt has the colours of
 // the edge it hangs from); the vertices after it are merged polygons', with `merged_colors`,
-// normal +z, shade 1 and texture coordinates (0, 0). Precondition: lattice from shade_terrain.
+// normal +z, shade 1 and texture coordinates (-1, -1) (the renderer draws their own colour
+// there, not the texture). Precondition: lattice from shade_terrain.
 TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
                               std::span<const glm::u8vec4> merged_colors);
 

@@ -4,6 +4,8 @@
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkDepthSortPolyData.h>
+#include <vtkLookupTable.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkPointData.h>
@@ -11,8 +13,12 @@
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextProperty.h>
 #include <vtkShaderProperty.h>
 #include <vtkSignedCharArray.h>
 #include <vtkTexture.h>
@@ -150,32 +156,47 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   property->LightingOff();  // the shading is baked into the colours (terrain_colors.h)
   property->SetColor(1.0, 1.0, 1.0);
   if (settings.wireframe) property->SetRepresentationToWireframe();
-  if (settings.haze_distance > 0.0) {
-    // The haze of each vertex from its depth along the view axis (clip-space w), interpolated,
-    // and mixed in after VTK's own colour and texture code. Per fragment (depth linearised
-    // from gl_FragCoord.z) it cost about 18 ms more per 1280x720 frame on llvmpipe, where
-    // back-to-front drawing shades every layer of the terrain; per vertex the difference is
-    // invisible (the fade is smooth and coarse triangles are far).
-    vtkShaderProperty* shader = actor_->GetShaderProperty();
-    shader->AddVertexShaderReplacement("//VTK::PositionVC::Dec", true,
-                                       "//VTK::PositionVC::Dec\nout float hazeAmount;\n", false);
-    shader->AddVertexShaderReplacement(
-        "//VTK::PositionVC::Impl", true,
-        "//VTK::PositionVC::Impl\n  hazeAmount = 0.85 * (1.0 - exp(-gl_Position.w / hazeDistance));\n", false);
-    shader->AddFragmentShaderReplacement("//VTK::PositionVC::Dec", true,
-                                         "//VTK::PositionVC::Dec\nin float hazeAmount;\n", false);
-    shader->AddFragmentShaderReplacement(
-        "//VTK::TCoord::Impl", true,
-        "//VTK::TCoord::Impl\n  gl_FragData[0].rgb = mix(gl_FragData[0].rgb, hazeColor, hazeAmount);\n", false);
-    shader->GetVertexCustomUniforms()->SetUniformf("hazeDistance", static_cast<float>(settings.haze_distance));
-    const float color[3] = {settings.haze_color[0] / 255.0f, settings.haze_color[1] / 255.0f,
-                            settings.haze_color[2] / 255.0f};
-    shader->GetFragmentCustomUniforms()->SetUniform3f("hazeColor", color);
+
+  if (split_orders()) {
+    merged_poly_->SetPoints(poly_->GetPoints());
+    merged_poly_->GetPointData()->SetScalars(poly_->GetPointData()->GetScalars());
+    merged_poly_->SetPolys(vtkNew<vtkCellArray>());
+    if (settings.order == DrawOrder::kSort) {
+      vtkNew<vtkDepthSortPolyData> sort;
+      sort->SetInputData(merged_poly_);
+      sort->SetCamera(renderer_->GetActiveCamera());
+      sort->SetDirectionToBackToFront();
+      sort->SetDepthSortModeToParametricCenter();
+      merged_mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
+      merged_mapper_->SetInputConnection(sort->GetOutputPort());
+    } else {
+      merged_mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
+      merged_mapper_->SetInputData(merged_poly_);
+    }
+    merged_mapper_->SetColorModeToDirectScalars();
+    merged_mapper_->InterpolateScalarsBeforeMappingOff();
+    merged_mapper_->ScalarVisibilityOn();
+    merged_actor_->SetMapper(merged_mapper_);
+    merged_actor_->ForceTranslucentOn();
+    merged_actor_->GetProperty()->LightingOff();
+    merged_actor_->GetProperty()->BackfaceCullingOff();
+    if (settings.wireframe) merged_actor_->GetProperty()->SetRepresentationToWireframe();
+    install_shaders(*merged_actor_, false);
+    renderer_->AddActor(merged_actor_);
+    renderer_->SetUseDepthPeeling(settings.order == DrawOrder::kPeel);
+    if (settings.order == DrawOrder::kSort) {
+      // VTK 9.1 draws translucent geometry with weighted blended order-independent
+      // translucency when depth peeling is off, which ignores the order of the cells; the
+      // plain render steps blend in the sorted order instead.
+      renderer_->SetPass(vtkNew<vtkRenderStepsPass>());
+    }
+    renderer_->SetMaximumNumberOfPeels(0);  // no limit
+    renderer_->SetOcclusionRatio(0.0);      // peel until no pixel changes: exact
   }
   apply_color_mode();
 
   renderer_->AddActor(actor_);
-  renderer_->UseDepthPeelingOff();
+  if (!split_orders()) renderer_->UseDepthPeelingOff();
   renderer_->UseFXAAOff();
   renderer_->AutomaticLightCreationOff();
   double c[3];
@@ -191,7 +212,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   window_->SetDisplayId(shared_display());  // not owned: VTK leaves it open
   window_->SetOffScreenRendering(settings.offscreen ? 1 : 0);
   window_->SetMultiSamples(0);
-  window_->SetAlphaBitPlanes(0);
+  window_->SetAlphaBitPlanes(settings.order == DrawOrder::kPeel ? 1 : 0);  // depth peeling needs alpha
   window_->SetSize(settings.width, settings.height);
   window_->AddRenderer(renderer_);
 }
@@ -204,20 +225,49 @@ void TerrainRenderer::set_camera(const mrbsp::Camera& camera, double far_plane) 
   apply_camera(camera, far_plane, *renderer_->GetActiveCamera());
 }
 
-void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
-  const auto triangles = static_cast<vtkIdType>(frame.indices.size() / 3);
+namespace {
+
+vtkNew<vtkCellArray> triangle_cells(const std::vector<std::uint32_t>& indices) {
   vtkNew<vtkTypeInt32Array> connectivity;
-  connectivity->SetNumberOfValues(3 * triangles);
+  connectivity->SetNumberOfValues(static_cast<vtkIdType>(indices.size()));
   std::int32_t* out = connectivity->GetPointer(0);
-  for (std::size_t k = 0; k < frame.indices.size(); ++k) out[k] = static_cast<std::int32_t>(frame.indices[k]);
+  for (std::size_t k = 0; k < indices.size(); ++k) out[k] = static_cast<std::int32_t>(indices[k]);
   vtkNew<vtkCellArray> polys;
   polys->SetData(3, connectivity);
-  poly_->SetPolys(polys);
+  return polys;
+}
+
+}  // namespace
+
+void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
+  // The split orders draw the merged triangles with a second actor: the terrain's list keeps
+  // the rest, in the frame's order.
+  std::vector<std::uint32_t> merged;
+  std::vector<std::int8_t> levels(frame.level.begin(), frame.level.end());
+  const std::vector<std::uint32_t>* terrain = &frame.indices;
+  std::vector<std::uint32_t> kept;
+  if (split_orders()) {
+    kept.reserve(frame.indices.size());
+    levels.clear();
+    for (std::size_t t = 0; 3 * t < frame.indices.size(); ++t) {
+      const int lv = t < frame.level.size() ? frame.level[t] : mrbsp::kSkirtLevel;
+      auto& to = lv == mrbsp::kMergedLevel ? merged : kept;
+      to.insert(to.end(), frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+      if (lv != mrbsp::kMergedLevel) levels.push_back(static_cast<std::int8_t>(lv));
+    }
+    terrain = &kept;
+    merged_poly_->SetPolys(triangle_cells(merged));
+    merged_poly_->Modified();
+  }
+  const auto triangles = static_cast<vtkIdType>(terrain->size() / 3);
+  poly_->SetPolys(triangle_cells(*terrain));
 
   vtkNew<vtkSignedCharArray> level;
   level->SetName("level");
   level->SetNumberOfValues(triangles);
-  std::copy(frame.level.begin(), frame.level.begin() + std::min<std::size_t>(frame.level.size(), triangles),
+  std::fill_n(level->GetPointer(0), triangles, static_cast<signed char>(mrbsp::kSkirtLevel));
+  std::copy(levels.begin(), levels.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(levels.size()), triangles),
             level->GetPointer(0));
   poly_->GetCellData()->AddArray(level);
 
@@ -228,8 +278,8 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     colors->SetNumberOfTuples(triangles);
     auto* rgba = reinterpret_cast<Rgba*>(colors->GetPointer(0));
     for (vtkIdType t = 0; t < triangles; ++t) {
-      const int lv = t < static_cast<vtkIdType>(frame.level.size()) ? frame.level[t] : mrbsp::kSkirtLevel;
-      const std::uint32_t* v = &frame.indices[3 * t];
+      const int lv = level->GetValue(t);
+      const std::uint32_t* v = &(*terrain)[static_cast<std::size_t>(3 * t)];
       if (lv == mrbsp::kSkirtLevel) {
         rgba[t] = kSkirtColor;
         continue;
@@ -246,23 +296,59 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   poly_->Modified();
 }
 
+// The fragment colour: with the texture, a terrain vertex's texture coordinates are >= 0 and
+// the texture gives the colour; a merged vertex's are (-1, -1) (vertex_shading) and its own
+// RGBA does (a triangle is all terrain or all merged, so the interpolated coordinate keeps
+// the sign). VTK's own texture code would multiply the two. Then the haze, if any.
+void TerrainRenderer::install_shaders(vtkActor& actor, bool textured) {
+  vtkShaderProperty* shader = actor.GetShaderProperty();
+  shader->ClearAllShaderReplacements();
+  std::string colour = textured ? "  if (tcoordVCVSOutput.s < 0.0) { gl_FragData[0] = vertexColorVSOutput; }\n"
+                                  "  else { gl_FragData[0] = texture(actortexture, tcoordVCVSOutput.st); }\n"
+                                : "//VTK::TCoord::Impl\n";
+  if (settings_.haze_distance > 0.0) {
+    // The haze of each vertex from its depth along the view axis (clip-space w), interpolated,
+    // and mixed in after the colour. Per fragment (depth linearised from gl_FragCoord.z) it
+    // cost about 18 ms more per 1280x720 frame on llvmpipe, where back-to-front drawing shades
+    // every layer of the terrain; per vertex the difference is invisible (the fade is smooth
+    // and coarse triangles are far).
+    shader->AddVertexShaderReplacement("//VTK::PositionVC::Dec", true,
+                                       "//VTK::PositionVC::Dec\nout float hazeAmount;\n", false);
+    shader->AddVertexShaderReplacement(
+        "//VTK::PositionVC::Impl", true,
+        "//VTK::PositionVC::Impl\n  hazeAmount = 0.85 * (1.0 - exp(-gl_Position.w / hazeDistance));\n", false);
+    shader->AddFragmentShaderReplacement("//VTK::PositionVC::Dec", true,
+                                         "//VTK::PositionVC::Dec\nin float hazeAmount;\n", false);
+    colour += "  gl_FragData[0].rgb = mix(gl_FragData[0].rgb, hazeColor, hazeAmount);\n";
+    const double distance = settings_.lod_colors ? 1e30 : settings_.haze_distance;
+    shader->GetVertexCustomUniforms()->SetUniformf("hazeDistance", static_cast<float>(distance));
+    const float color[3] = {settings_.haze_color[0] / 255.0f, settings_.haze_color[1] / 255.0f,
+                            settings_.haze_color[2] / 255.0f};
+    shader->GetFragmentCustomUniforms()->SetUniform3f("hazeColor", color);
+  }
+  shader->AddFragmentShaderReplacement("//VTK::TCoord::Impl", true, colour, false);
+}
+
 void TerrainRenderer::apply_color_mode() {
   const bool textured = texture_side_ > 0 && !settings_.lod_colors;
   actor_->SetTexture(textured ? texture_.GetPointer() : nullptr);
-  if (textured) {
-    mapper_->ScalarVisibilityOff();  // the texture gives the colour
-  } else if (settings_.lod_colors) {
-    mapper_->ScalarVisibilityOn();
+  mapper_->ScalarVisibilityOn();  // the merged polygons' colours, also under the texture
+  if (settings_.lod_colors) {
     mapper_->SetScalarModeToUseCellFieldData();
     mapper_->SelectColorArray("lod_rgba");
   } else {
-    mapper_->ScalarVisibilityOn();
     mapper_->SetScalarModeToUsePointData();
   }
-  if (settings_.haze_distance > 0.0) {  // the shader replacement exists: fade, or not at all
-    const double distance = settings_.lod_colors ? 1e30 : settings_.haze_distance;
-    actor_->GetShaderProperty()->GetVertexCustomUniforms()->SetUniformf("hazeDistance", static_cast<float>(distance));
-  }
+  install_shaders(*actor_, textured);
+  if (split_orders()) install_shaders(*merged_actor_, false);
+}
+
+void TerrainRenderer::set_background(const Rgb& bottom, const Rgb& top) {
+  double c[3];
+  set_rgb(bottom, c);
+  renderer_->SetBackground(c);
+  set_rgb(top, c);
+  renderer_->SetBackground2(c);
 }
 
 void TerrainRenderer::set_lod_colors(bool on) {
@@ -273,23 +359,31 @@ void TerrainRenderer::set_lod_colors(bool on) {
 
 void TerrainRenderer::set_wireframe(bool on) {
   settings_.wireframe = on;
-  if (on) {
-    actor_->GetProperty()->SetRepresentationToWireframe();
-  } else {
-    actor_->GetProperty()->SetRepresentationToSurface();
+  for (vtkActor* a : {actor_.GetPointer(), merged_actor_.GetPointer()}) {
+    if (on) {
+      a->GetProperty()->SetRepresentationToWireframe();
+    } else {
+      a->GetProperty()->SetRepresentationToSurface();
+    }
   }
 }
 
 void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
                                        const ColorTexture& texture) {
   const std::size_t n = positions.size();
-  if (n != static_cast<std::size_t>(poly_->GetNumberOfPoints()) || shading.rgba.size() != n ||
-      shading.normals.size() != n || shading.shade.size() != n || texture.side != texture_side_ ||
+  if (shading.rgba.size() != n || shading.normals.size() != n || shading.shade.size() != n ||
+      texture.side != texture_side_ || (texture_side_ > 0 && shading.tcoords.size() != n) ||
       texture.rgba.size() != static_cast<std::size_t>(texture.side) * texture.side) {
-    throw std::invalid_argument("TerrainRenderer::replace_vertices: " + std::to_string(n) + " positions for " +
-                                std::to_string(poly_->GetNumberOfPoints()) + " vertices, or attributes that differ");
+    throw std::invalid_argument("TerrainRenderer::replace_vertices: " + std::to_string(n) +
+                                " positions with attributes or a texture that differ");
   }
-  auto copy = [](vtkDataArray* to, const void* from, std::size_t bytes) {
+  // The triangles index the old vertices: none until the next set_frame().
+  poly_->SetPolys(vtkNew<vtkCellArray>());
+  poly_->GetCellData()->Initialize();
+  if (split_orders()) merged_poly_->SetPolys(vtkNew<vtkCellArray>());
+  const auto count = static_cast<vtkIdType>(n);
+  auto copy = [count](vtkDataArray* to, const void* from, std::size_t bytes) {
+    to->SetNumberOfTuples(count);  // keeps the allocation when the count is unchanged
     std::memcpy(to->GetVoidPointer(0), from, bytes);
     to->Modified();
   };
@@ -297,13 +391,56 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   poly_->GetPoints()->Modified();
   copy(poly_->GetPointData()->GetNormals(), shading.normals.data(), n * sizeof(glm::vec3));
   copy(poly_->GetPointData()->GetScalars(), shading.rgba.data(), n * sizeof(Rgba));
-  shade_ = shading.shade;
-  point_rgba_ = shading.rgba;
   if (texture_side_ > 0) {
+    copy(poly_->GetPointData()->GetTCoords(), shading.tcoords.data(), n * sizeof(glm::vec2));
     copy(texture_image_->GetPointData()->GetScalars(), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
     texture_image_->Modified();
   }
+  shade_ = shading.shade;
+  point_rgba_ = shading.rgba;
   poly_->Modified();
+  if (split_orders()) merged_poly_->Modified();
+}
+
+void TerrainRenderer::set_legend(const Legend& legend) {
+  if (legend_ != nullptr) renderer_->RemoveActor2D(legend_);
+  legend_ = nullptr;
+  if (legend.colors.empty()) return;
+  vtkNew<vtkLookupTable> table;
+  const bool discrete = !legend.labels.empty();
+  table->SetNumberOfTableValues(static_cast<vtkIdType>(legend.colors.size()));
+  for (std::size_t k = 0; k < legend.colors.size(); ++k) {
+    const Rgb& c = legend.colors[k];
+    table->SetTableValue(static_cast<vtkIdType>(k), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
+  }
+  if (discrete) {
+    table->IndexedLookupOn();
+    for (std::size_t k = 0; k < legend.labels.size(); ++k) {
+      table->SetAnnotation(vtkVariant(static_cast<int>(k)), legend.labels[k]);
+    }
+  } else {
+    table->SetTableRange(legend.lo, legend.hi);
+  }
+  table->Build();
+  legend_ = vtkSmartPointer<vtkScalarBarActor>::New();
+  legend_->SetLookupTable(table);
+  legend_->SetTitle(legend.title.c_str());
+  legend_->SetNumberOfLabels(5);
+  legend_->SetOrientationToVertical();
+  legend_->SetPosition(0.88, 0.08);
+  legend_->SetWidth(0.1);
+  legend_->SetHeight(0.5);
+  legend_->DrawBackgroundOn();
+  legend_->GetBackgroundProperty()->SetColor(0.1, 0.1, 0.1);
+  legend_->GetBackgroundProperty()->SetOpacity(0.55);
+  for (vtkTextProperty* t : {legend_->GetTitleTextProperty(), legend_->GetLabelTextProperty(),
+                             legend_->GetAnnotationTextProperty()}) {
+    t->SetColor(1.0, 1.0, 1.0);
+    t->ShadowOff();
+    t->ItalicOff();
+    t->SetFontSize(12);
+  }
+  renderer_->AddActor2D(legend_);
 }
 
 double TerrainRenderer::render() {

@@ -1,7 +1,9 @@
 // The VTK side of a terrain render: one vtkPolyData holding every vertex of the tree (positions,
 // normals, RGBA, uploaded once), whose triangle list is replaced by each traversal, drawn
 // either in tree order with no depth test (OrderedPolyDataMapper) or with VTK's ordinary
-// depth-tested mapper (the correctness reference), into an offscreen window.
+// depth-tested mapper (the references), into an offscreen window. Merged polygons (isosurfaces,
+// slices: Frame::level kMergedLevel) are drawn with their own RGBA; the terrain with its
+// texture.
 #pragma once
 
 #include <vtkNew.h>
@@ -10,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -24,6 +27,7 @@ class vtkPolyData;
 class vtkPolyDataMapper;
 class vtkRenderer;
 class vtkRenderWindow;
+class vtkScalarBarActor;
 class vtkTexture;
 
 namespace terravol::app {
@@ -31,6 +35,12 @@ namespace terravol::app {
 enum class DrawOrder : std::uint8_t {
   kBsp,      // the tree's back-to-front order, depth test off (OrderedPolyDataMapper)
   kZBuffer,  // the same triangles in the same order, vtkPolyDataMapper with the depth test on
+  // The references for translucency, all with the terrain opaque and depth-tested and the
+  // merged triangles of the same frame in a second, translucent actor:
+  kPeel,  // VTK's depth peeling, no limit on peels, occlusion ratio 0: exact
+  kVtk,   // VTK 9.1's default translucent pass: weighted blended order-independent
+          // translucency (McGuire and Bavoil 2013), depth test on
+  kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
 };
 
 using Rgb = std::array<std::uint8_t, 3>;
@@ -90,17 +100,33 @@ class TerrainRenderer {
   // Draws one frame and waits for the GPU to finish it; returns wall milliseconds.
   double render();
 
+  // The sky gradient's colours (bottom, top), or the uniform background (bottom) when the
+  // settings have no gradient.
+  void set_background(const Rgb& bottom, const Rgb& top);
+
   // Display switches for the interactive viewer; they take effect at the next set_frame() and
   // render(). LOD colours replace the texture and turn the haze off while on.
   void set_lod_colors(bool on);
   void set_wireframe(bool on);
 
-  // Sliding (terravol view): every vertex gets a new position and attributes (the tree's
-  // positions() after TerrainTree::slide(), the shading and texture of the moved window); the
-  // counts and the texture side must be those given to the constructor, else
-  // std::invalid_argument. The triangle list is kept until the next set_frame().
+  // Sliding and re-merging (terravol view): every vertex gets a new position and attributes
+  // (the tree's positions() after TerrainTree::slide() or merge(), the shading and texture of
+  // the window). The vertex count may change (merged polygons come and go); the texture side
+  // must be the constructor's, and the attribute counts must match the positions, else
+  // std::invalid_argument. The triangle list is emptied until the next set_frame().
   void replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
                         const ColorTexture& texture = {});
+
+  // A colour legend (vtkScalarBarActor) in the lower right, or none when `legend.colors` is
+  // empty. Continuous: colours sampled evenly over [lo, hi]; discrete (isosurfaces): one
+  // swatch per entry of `labels`, colours[k] for labels[k].
+  struct Legend {
+    std::string title;
+    double lo = 0.0, hi = 1.0;
+    std::vector<Rgb> colors;
+    std::vector<std::string> labels;  // empty: continuous
+  };
+  void set_legend(const Legend& legend);
 
   // The last rendered image, encoded as PNG.
   std::vector<std::uint8_t> png() const;
@@ -115,6 +141,8 @@ class TerrainRenderer {
 
  private:
   void apply_color_mode();
+  void install_shaders(vtkActor& actor, bool textured);
+  bool split_orders() const { return settings_.order != DrawOrder::kBsp && settings_.order != DrawOrder::kZBuffer; }
 
   RenderSettings settings_;
   std::vector<float> shade_;      // per vertex, for --lod-colors
@@ -125,6 +153,11 @@ class TerrainRenderer {
   vtkNew<vtkTexture> texture_;
   vtkSmartPointer<vtkPolyDataMapper> mapper_;
   vtkNew<vtkActor> actor_;
+  // kPeel, kVtk, kSort: the merged triangles, translucent, sharing poly_'s points.
+  vtkNew<vtkPolyData> merged_poly_;
+  vtkSmartPointer<vtkPolyDataMapper> merged_mapper_;
+  vtkNew<vtkActor> merged_actor_;
+  vtkSmartPointer<vtkScalarBarActor> legend_;
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkRenderWindow> window_;
 };

@@ -99,6 +99,12 @@ class TerrainScene {
   float max_z() const { return max_z_; }
 
   const mrbsp::TerrainTree& tree() const { return tree_; }
+  // Merges polygons into the tree (TerrainTree::merge: replaces those merged before; slide()
+  // merges them again into the moved window).
+  mrbsp::MergeStats merge(std::span<const glm::dvec3> vertices, std::span<const glm::u8vec4> colors,
+                          std::span<const std::uint32_t> triangles) {
+    return tree_.merge(vertices, colors, triangles);
+  }
   double build_ms() const { return build_ms_; }  // the tree's constructor alone, wall clock
 
   // Bilinear height (metres, datum) at a geographic point; points outside the window are

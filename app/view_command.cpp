@@ -6,6 +6,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "app/scene_file.h"
 #include "app/render_options.h"
 #include "app/viewer.h"
 
@@ -19,45 +20,80 @@ void add_view_command(CLI::App& app) {
     std::string camera, size = "1280x720", metric = "error", tint = "atlas";
     double threshold = 0.0;
     bool no_slide = false;
+    std::filesystem::path scene;
+    std::vector<std::filesystem::path> volumes;
+    std::vector<std::string> isos, slices;
+    std::string volume_frame, field;
+    bool no_legend = false;
   };
   auto raw = std::make_shared<Raw>();
   ViewOptions& o = raw->o;
-  cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic)")->required();
-  cmd->add_option("--camera", raw->camera,
+  cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic); default: the scene file's");
+  cmd->add_option("--scene", raw->scene,
+                  "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
+  cmd->add_option("--volume", raw->volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
+  cmd->add_option("--field", raw->field, "The --volume files' grid or array (default: the first)");
+  cmd->add_option("--volume-frame", raw->volume_frame,
+                  "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
+  cmd->add_option("--iso", raw->isos, "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume; repeatable");
+  cmd->add_option("--slice", raw->slices,
+                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume; repeatable");
+  cmd->add_flag("--no-legend", raw->no_legend, "No colour legend for the volumes");
+  auto* camera = cmd->add_option("--camera", raw->camera,
                   "LAT,LON,ALT,HEADING,PITCH: degrees, metres (in the DEM's datum; above ground with --agl), "
                   "heading clockwise from north, pitch above the horizon (default: 1500 m above the "
                   "mosaic's centre, looking north)");
   cmd->add_flag("--agl", o.agl, "ALT is metres above the ground under the camera");
-  cmd->add_option("--size", raw->size, "Window size WIDTHxHEIGHT, pixels")->capture_default_str();
-  cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
-  cmd->add_option("--lod-metric", raw->metric, "LOD metric at the start: error or area (key M switches)")
+  auto* size = cmd->add_option("--size", raw->size, "Window size WIDTHxHEIGHT, pixels")->capture_default_str();
+  auto* fov = cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
+  auto* metric = cmd->add_option("--lod-metric", raw->metric, "LOD metric at the start: error or area (key M switches)")
       ->capture_default_str();
   auto* threshold = cmd->add_option("--threshold", raw->threshold,
                                     "LOD threshold at the start: pixels of screen-space error (default 2) or, "
                                     "with --lod-metric area, square pixels (default 500)");
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
-  cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
+  auto* window = cmd->add_option("--window", o.max_window, "Largest window side, cells (a power of two)")->capture_default_str();
   cmd->add_option("--speed", o.flight.speed_factor,
                   "Flight speed: metres per second for each metre above the ground")
       ->capture_default_str();
   cmd->add_flag("--lod-colors", o.lod_colors, "Start with each LOD level in its own colour (key L)");
   cmd->add_flag("--wireframe", o.wireframe, "Start in wireframe (key T)");
   cmd->add_flag("--no-slide", raw->no_slide, "Start with automatic sliding of the window off (key G)");
-  cmd->add_option("--haze", o.haze_km, "Aerial perspective: distance (km) at which 63% of the colour fades; 0: none")
+  auto* haze = cmd->add_option("--haze", o.haze_km, "Aerial perspective: distance (km) at which 63% of the colour fades; 0: none")
       ->capture_default_str();
-  cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
+  auto* tint = cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
       ->capture_default_str();
   cmd->add_option("--status", o.status, "After every frame, write the viewer's state to this JSON file");
   cmd->add_option("--screenshot", o.screenshot,
                   "Where key P writes the view (PNG, replaced each time; default terravol-view-NNN.png here)");
-  cmd->callback([raw, levels, threshold] {
+  cmd->callback([=] {
     ViewOptions& opt = raw->o;
-    if (!raw->camera.empty()) opt.pose = parse_camera_pose(raw->camera);
+    // The scene file first; whatever the command line gave wins.
+    SceneSpec file;
+    if (!raw->scene.empty()) file = load_scene_file(raw->scene);
+    const SceneStyle& st = file.style;
+    if (opt.dems.empty()) opt.dems = file.dems;
+    if (opt.dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
+    if (camera->count() > 0) {
+      opt.pose = parse_camera_pose(raw->camera);
+    } else if (file.camera) {
+      opt.pose = file.camera->pose;
+      opt.agl = opt.agl || file.camera->agl;
+      if (fov->count() == 0) opt.fov_y_deg = file.camera->fov_y_deg;
+    }
+    if (size->count() == 0 && st.width) raw->size = std::to_string(*st.width) + "x" + std::to_string(*st.height);
+    if (metric->count() == 0 && st.lod_metric) raw->metric = *st.lod_metric;
+    if (tint->count() == 0 && st.tint) raw->tint = *st.tint;
+    if (threshold->count() == 0 && st.threshold) raw->threshold = *st.threshold;
+    if (window->count() == 0 && st.window) opt.max_window = *st.window;
+    if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
+    opt.legend = !raw->no_legend && st.legend.value_or(true);
+    opt.volumes = volumes_from_options(file.volumes, raw->volumes, raw->field, raw->volume_frame, raw->isos, raw->slices);
     parse_size(raw->size, opt.width, opt.height);
     opt.traversal.metric = parse_metric(raw->metric);
     opt.shading.tint = parse_tint(raw->tint);
     opt.auto_slide = !raw->no_slide;
-    if (threshold->count() == 0) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
+    if (threshold->count() == 0 && !st.threshold) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
     if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
       throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
     }

@@ -46,6 +46,7 @@
 #include "app/png_output.h"
 #include "app/terrain_renderer.h"
 #include "app/terrain_scene.h"
+#include "app/volume_layer.h"
 #include "app/write_file.h"
 #include "io/error.h"
 #include "io/mosaic.h"
@@ -64,6 +65,9 @@ const char* const kViewKeys =
     "L            LOD colours\n"
     "T            wireframe (triangle edges)\n"
     "G            automatic sliding of the window\n"
+    "1 .. 9       show or hide volume N (and select it)\n"
+    "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
+    ", / .        lower / raise its first isosurface's level by 2 units\n"
     "P            screenshot (PNG)\n"
     "Home         back to the starting pose\n"
     "H            show or hide this list\n"
@@ -162,10 +166,16 @@ class Viewer {
   bool held(const char* key) const { return held_.count(key) > 0 || tapped_.count(key) > 0; }
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void clamp_to_mosaic(CameraPose& p) const;
+  void volume_key(const std::string& key);
+  void upload_vertices();
 
   ViewOptions o_;
   io::Mosaic mosaic_;
   std::unique_ptr<TerrainScene> scene_;
+  TerrainShading lattice_;    // the window's lattice shading (its colours are the texture)
+  VolumeLayer volumes_;
+  std::size_t selected_volume_ = 0;
+  double last_merge_ms_ = 0;  // the last interactive change of a volume, extraction to upload
   std::future<PreparedSlide> pending_slide_;  // destroyed (waited for) before the mosaic
   std::unique_ptr<TerrainRenderer> renderer_;
   mrbsp::Frame frame_;
@@ -323,12 +333,14 @@ Viewer::Viewer(const ViewOptions& options)
   settings.haze_color = kHorizon;
   settings.haze_distance = o_.haze_km * 1000.0;
   settings.offscreen = false;
-  const TerrainShading lattice =
-      shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), o_.shading);
+  volumes_ = VolumeLayer(o_.volumes, mosaic_, scene_->frame());
+  volumes_.merge_into(*scene_);
+  lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), o_.shading);
   const mrbsp::TerrainTree& tree = scene_->tree();
   renderer_ = std::make_unique<TerrainRenderer>(tree.positions(),
-                                                vertex_shading(lattice, tree.merged_base(), tree.merged_colors()),
-                                                settings, ColorTexture{scene_->cells() + 1, lattice.rgba});
+                                                vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+                                                settings, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  if (o_.legend) renderer_->set_legend(volumes_.legend());
   vtkRenderWindow* win = renderer_->window();
   std::string title = "Terravol view - " + o_.dems.front().filename().string();
   if (o_.dems.size() > 1) title += " + " + std::to_string(o_.dems.size() - 1) + " more";
@@ -488,6 +500,9 @@ void Viewer::key_press(const std::string& key) {
     help_text_->SetVisibility(help_);
   } else if (key == "Home") {
     pose_ = start_pose_;
+  } else if ((key.size() == 1 && key[0] >= '1' && key[0] <= '9') || key == "bracketleft" ||
+             key == "bracketright" || key == "comma" || key == "period") {
+    volume_key(key);
   } else if (key == "equal" || key == "plus" || key == "KP_Add") {
     set_threshold(threshold() / std::sqrt(2.0));
   } else if (key == "minus" || key == "KP_Subtract") {
@@ -562,6 +577,74 @@ void Viewer::tick() {
     dirty_ = false;
     draw_frame();
   }
+}
+
+// Number keys toggle (and select) a volume; [ ] move its first slice, , . its first
+// isosurface. Each change re-extracts that one piece of geometry, merges all visible geometry
+// into the tree again and uploads the vertices; the overlay and the status say how long it took.
+void Viewer::volume_key(const std::string& key) {
+  if (volumes_.size() == 0) {
+    message_ = "no volumes (give --volume or --scene)";
+    return;
+  }
+  const auto t0 = Clock::now();
+  std::string what;
+  try {
+    if (key[0] >= '1' && key[0] <= '9') {
+      const std::size_t v = static_cast<std::size_t>(key[0] - '1');
+      if (v >= volumes_.size()) {
+        message_ = "there is no volume " + key;
+        return;
+      }
+      selected_volume_ = v;
+      volumes_.set_visible(v, !volumes_.spec(v).visible);
+      what = "volume " + key + (volumes_.spec(v).visible ? " shown" : " hidden");
+    } else if (key == "bracketleft" || key == "bracketright") {
+      const VolumeSpec& spec = volumes_.spec(selected_volume_);
+      if (spec.slices.empty()) {
+        message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no slice";
+        return;
+      }
+      volume::SliceSpec s = spec.slices.front();
+      const bool degrees = s.kind == volume::SliceKind::kLat || s.kind == volume::SliceKind::kLon;
+      s.value += (key == "bracketright" ? 1.0 : -1.0) * (degrees ? 0.01 : 50.0);
+      volumes_.set_slice(selected_volume_, 0, s);
+      char b[96];
+      std::snprintf(b, sizeof b, "slice %s %g%s", std::string(volume::slice_kind_name(s.kind)).c_str(), s.value,
+                    degrees ? " deg" : " m");
+      what = b;
+    } else {
+      const VolumeSpec& spec = volumes_.spec(selected_volume_);
+      if (spec.isosurfaces.empty()) {
+        message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no isosurface";
+        return;
+      }
+      volume::IsoSpec iso = spec.isosurfaces.front();
+      iso.value += key == "period" ? 2.0f : -2.0f;
+      volumes_.set_isosurface(selected_volume_, 0, iso);
+      char b[64];
+      std::snprintf(b, sizeof b, "isosurface %g", static_cast<double>(iso.value));
+      what = b;
+    }
+  } catch (const std::invalid_argument& e) {
+    message_ = e.what();  // e.g. a slice moved out of its volume: nothing changed
+    return;
+  }
+  const double geometry_ms = volumes_.figures().geometry_ms;
+  volumes_.merge_into(*scene_);
+  upload_vertices();
+  if (o_.legend) renderer_->set_legend(volumes_.legend());
+  last_merge_ms_ = ms_between(t0, Clock::now());
+  char b[160];
+  std::snprintf(b, sizeof b, "%s: %.0f ms (geometry %.0f, merge %.0f)", what.c_str(), last_merge_ms_, geometry_ms,
+                volumes_.figures().merge_ms);
+  message_ = b;
+}
+
+void Viewer::upload_vertices() {
+  const mrbsp::TerrainTree& tree = scene_->tree();
+  renderer_->replace_vertices(tree.positions(), vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+                              ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
 void Viewer::slider_moved() {
@@ -640,9 +723,14 @@ void Viewer::finish_slide() {
     return;
   }
   const auto t0 = Clock::now();
-  scene_->slide(std::move(p.window));
+  scene_->slide(std::move(p.window));  // merges the volumes again into the moved window
+  lattice_ = std::move(p.lattice);
   const auto t1 = Clock::now();
-  renderer_->replace_vertices(scene_->tree().positions(), p.vertices, ColorTexture{scene_->cells() + 1, p.lattice.rgba});
+  if (volumes_.size() > 0) {
+    // The merged vertices were made anew by the slide: their count and colours changed.
+    p.vertices = vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  }
+  renderer_->replace_vertices(scene_->tree().positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
   const auto t2 = Clock::now();
   slide_parts_ = {p.read_ms, p.shade_ms, ms_between(t0, t1), ms_between(t1, t2)};
   last_slide_ms_ = ms_between(t0, t2);
@@ -785,6 +873,20 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                               {"tree", slide_parts_[2]},
                               {"vertices", slide_parts_[3]}};
   j["slide_pending"] = pending_slide_.valid();
+  j["volumes"] = ordered_json::array();
+  for (std::size_t v = 0; v < volumes_.size(); ++v) {
+    const VolumeSpec& spec = volumes_.spec(v);
+    ordered_json jv;
+    jv["visible"] = spec.visible;
+    jv["isovalues"] = ordered_json::array();
+    for (const auto& iso : spec.isosurfaces) jv["isovalues"].push_back(iso.value);
+    jv["slices"] = ordered_json::array();
+    for (const auto& s : spec.slices) jv["slices"].push_back({{"kind", volume::slice_kind_name(s.kind)}, {"value", s.value}});
+    j["volumes"].push_back(jv);
+  }
+  j["merged_triangles"] = volumes_.figures().tree_triangles;
+  j["last_merge_ms"] = last_merge_ms_;
+  j["message"] = message_;
   // Nothing will draw another frame until something happens: no key held, no slide read
   // ahead, no overlay refresh or screenshot due.
   j["idle"] = held_.empty() && !pending_slide_.valid() && !overlay_stale_ && !screenshot_pending_ && !dirty_;

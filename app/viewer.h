@@ -10,6 +10,7 @@
 
 #include "app/camera.h"
 #include "app/flight.h"
+#include "app/scene_file.h"
 #include "app/terrain_colors.h"
 #include "mrbsp/terrain_tree.h"
 
@@ -32,6 +33,8 @@ struct ViewOptions {
   // After every rendered frame, a small JSON of the viewer's state (written to a temporary
   // name and renamed); empty: none.
   std::filesystem::path status;
+  std::vector<VolumeSpec> volumes;  // RF volumes and their styles
+  bool legend = true;               // a colour legend when volumes are drawn
   // Where the screenshot key writes (replaced each time, atomically); empty: the next free
   // terravol-view-NNN.png in the current folder.
   std::filesystem::path screenshot;

@@ -1,0 +1,28 @@
+// Ground heights over a rectangle of a DEM mosaic, voids filled, sampled bilinearly: the
+// ground under a volume (heights above ground, terrain-following slices) wherever the
+// terrain window is.
+#pragma once
+
+#include "io/grid.h"
+#include "io/mosaic.h"
+
+namespace terravol::app {
+
+class GroundGrid {
+ public:
+  GroundGrid() = default;
+  // Reads the mosaic's samples covering [south, north] x [west, east] degrees plus two
+  // samples on every side (at most 20000 x 20000) and fills their voids (io::fill_voids;
+  // samples no tile covers count as voids). Throws io::FormatError from the mosaic.
+  GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east);
+
+  // Metres in the DEM's datum at a geographic point, bilinear; clamped to the rectangle.
+  // Precondition: built by the reading constructor.
+  double operator()(double lat, double lon) const;
+
+ private:
+  io::Grid grid_;
+  double lat0_ = 0, lon0_ = 0, dlat_ = 1, dlon_ = 1;
+};
+
+}  // namespace terravol::app

@@ -1,0 +1,265 @@
+#include "app/scene_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <stdexcept>
+
+#include "app/render_options.h"
+#include "volume/colormap.h"
+
+namespace terravol::app {
+
+namespace {
+
+using nlohmann::json;
+
+// Errors name the document and the key's path, e.g. "scene.json: volumes[0].slices[1].agl: ...".
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw std::invalid_argument(source_ + ": " + where + ": " + what);
+  }
+
+  void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> allowed) const {
+    if (!j.is_object()) fail(where.empty() ? "(top level)" : where, "expected an object");
+    const std::set<std::string> ok(allowed.begin(), allowed.end());
+    for (const auto& [key, value] : j.items()) {
+      if (ok.count(key) == 0) {
+        std::string list;
+        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
+        fail(join(where, key), "unknown key (known: " + list + ")");
+      }
+    }
+  }
+
+  double number(const json& j, const std::string& where, double lo, double hi) const {
+    if (!j.is_number()) fail(where, "expected a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      fail(where, "must be within [" + format(lo) + ", " + format(hi) + "], is " + format(v));
+    }
+    return v;
+  }
+  bool boolean(const json& j, const std::string& where) const {
+    if (!j.is_boolean()) fail(where, "expected true or false");
+    return j.get<bool>();
+  }
+  std::string string(const json& j, const std::string& where) const {
+    if (!j.is_string() || j.get<std::string>().empty()) fail(where, "expected a non-empty string");
+    return j.get<std::string>();
+  }
+
+  static std::string join(const std::string& where, const std::string& key) {
+    return where.empty() ? key : where + "." + key;
+  }
+  static std::string at(const std::string& where, std::size_t k) { return where + "[" + std::to_string(k) + "]"; }
+
+ private:
+  static std::string format(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+  }
+  std::string source_;
+};
+
+std::filesystem::path resolve(const std::filesystem::path& base, const std::string& text) {
+  const std::filesystem::path p(text);
+  return p.is_absolute() ? p : base / p;
+}
+
+glm::u8vec3 rgb_of(const Reader& r, const json& j, const std::string& where) {
+  if (!j.is_array() || j.size() != 3) r.fail(where, "expected [R, G, B] with each 0..255");
+  glm::u8vec3 c;
+  for (int k = 0; k < 3; ++k) c[k] = static_cast<std::uint8_t>(r.number(j[static_cast<std::size_t>(k)], Reader::at(where, static_cast<std::size_t>(k)), 0, 255));
+  return c;
+}
+
+volume::IsoSpec iso_of(const Reader& r, const json& j, const std::string& where, std::size_t index) {
+  r.only_keys(j, where, {"value", "color", "opacity"});
+  if (!j.contains("value")) r.fail(where, "missing \"value\"");
+  volume::IsoSpec s;
+  s.value = static_cast<float>(r.number(j["value"], Reader::join(where, "value"), -1e30, 1e30));
+  const glm::u8vec3 palette = volume::default_isosurface_color(index);
+  s.color = j.contains("color") ? rgb_of(r, j["color"], Reader::join(where, "color")) : palette;
+  s.opacity = j.contains("opacity") ? r.number(j["opacity"], Reader::join(where, "opacity"), 0.0, 1.0) : 0.5;
+  return s;
+}
+
+volume::SliceSpec slice_of(const Reader& r, const json& j, const std::string& where) {
+  r.only_keys(j, where, {"lat", "lon", "alt", "agl", "opacity", "colormap", "range"});
+  volume::SliceSpec s;
+  int kinds = 0;
+  const std::pair<const char*, volume::SliceKind> names[] = {{"lat", volume::SliceKind::kLat},
+                                                             {"lon", volume::SliceKind::kLon},
+                                                             {"alt", volume::SliceKind::kAlt},
+                                                             {"agl", volume::SliceKind::kAgl}};
+  for (const auto& [name, kind] : names) {
+    if (!j.contains(name)) continue;
+    ++kinds;
+    s.kind = kind;
+    const bool degrees = kind == volume::SliceKind::kLat || kind == volume::SliceKind::kLon;
+    s.value = r.number(j[name], Reader::join(where, name), degrees ? -360.0 : -1e5, degrees ? 360.0 : 1e5);
+  }
+  if (kinds != 1) r.fail(where, "needs exactly one of lat, lon, alt, agl");
+  if (j.contains("opacity")) s.opacity = r.number(j["opacity"], Reader::join(where, "opacity"), 0.0, 1.0);
+  if (j.contains("colormap")) {
+    s.colormap = r.string(j["colormap"], Reader::join(where, "colormap"));
+    try {
+      volume::colormap_by_name(s.colormap);
+    } catch (const std::invalid_argument& e) {
+      r.fail(Reader::join(where, "colormap"), e.what());
+    }
+  }
+  if (j.contains("range")) {
+    const json& range = j["range"];
+    const std::string w = Reader::join(where, "range");
+    if (!range.is_array() || range.size() != 2) r.fail(w, "expected [LOW, HIGH]");
+    s.lo = static_cast<float>(r.number(range[0], Reader::at(w, 0), -1e30, 1e30));
+    s.hi = static_cast<float>(r.number(range[1], Reader::at(w, 1), -1e30, 1e30));
+    if (!(*s.lo < *s.hi)) r.fail(w, "LOW must be below HIGH");
+  }
+  return s;
+}
+
+VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& base) {
+  r.only_keys(j, where, {"file", "field", "frame", "visible", "isosurfaces", "slices"});
+  if (!j.contains("file")) r.fail(where, "missing \"file\"");
+  VolumeSpec v;
+  v.file = resolve(base, r.string(j["file"], Reader::join(where, "file")));
+  if (j.contains("field")) v.field = r.string(j["field"], Reader::join(where, "field"));
+  if (j.contains("frame")) {
+    v.frame = r.string(j["frame"], Reader::join(where, "frame"));
+    try {
+      volume::parse_frame(v.frame);
+    } catch (const std::invalid_argument& e) {
+      r.fail(Reader::join(where, "frame"), e.what());
+    }
+  }
+  if (j.contains("visible")) v.visible = r.boolean(j["visible"], Reader::join(where, "visible"));
+  for (const char* list : {"isosurfaces", "slices"}) {
+    if (!j.contains(list)) continue;
+    const std::string w = Reader::join(where, list);
+    if (!j[list].is_array()) r.fail(w, "expected a list");
+    for (std::size_t k = 0; k < j[list].size(); ++k) {
+      if (list[0] == 'i') {
+        v.isosurfaces.push_back(iso_of(r, j[list][k], Reader::at(w, k), k));
+      } else {
+        v.slices.push_back(slice_of(r, j[list][k], Reader::at(w, k)));
+      }
+    }
+  }
+  return v;
+}
+
+SceneCamera camera_of(const Reader& r, const json& j) {
+  r.only_keys(j, "camera", {"lat", "lon", "alt", "agl", "heading", "pitch", "fov"});
+  SceneCamera c;
+  for (const char* key : {"lat", "lon", "alt"}) {
+    if (!j.contains(key)) r.fail("camera", std::string("missing \"") + key + "\"");
+  }
+  c.pose.lat = r.number(j["lat"], "camera.lat", -85.0, 85.0);
+  c.pose.lon = r.number(j["lon"], "camera.lon", -360.0, 360.0);
+  c.pose.alt = r.number(j["alt"], "camera.alt", -500.0, 1e6);
+  if (j.contains("agl")) c.agl = r.boolean(j["agl"], "camera.agl");
+  if (j.contains("heading")) c.pose.heading_deg = r.number(j["heading"], "camera.heading", -720.0, 720.0);
+  if (j.contains("pitch")) c.pose.pitch_deg = r.number(j["pitch"], "camera.pitch", -90.0, 90.0);
+  if (j.contains("fov")) c.fov_y_deg = r.number(j["fov"], "camera.fov", 1.0, 179.0);
+  return c;
+}
+
+SceneStyle style_of(const Reader& r, const json& j) {
+  r.only_keys(j, "render", {"size", "threshold", "lod_metric", "order", "tint", "window", "haze_km", "sun_azimuth",
+                            "sun_elevation", "legend", "surface_triangles"});
+  SceneStyle s;
+  auto text = [&](const char* key, auto check) -> std::optional<std::string> {
+    if (!j.contains(key)) return std::nullopt;
+    const std::string v = r.string(j[key], std::string("render.") + key);
+    try {
+      check(v);
+    } catch (const std::invalid_argument& e) {
+      r.fail(std::string("render.") + key, e.what());
+    }
+    return v;
+  };
+  if (j.contains("size")) {
+    int w = 0, h = 0;
+    try {
+      parse_size(r.string(j["size"], "render.size"), w, h);
+    } catch (const std::invalid_argument& e) {
+      r.fail("render.size", e.what());
+    }
+    s.width = w;
+    s.height = h;
+  }
+  if (j.contains("threshold")) s.threshold = r.number(j["threshold"], "render.threshold", 1e-3, 1e7);
+  s.lod_metric = text("lod_metric", [](const std::string& v) { parse_metric(v); });
+  s.order = text("order", [](const std::string& v) { parse_order(v); });
+  s.tint = text("tint", [](const std::string& v) { parse_tint(v); });
+  if (j.contains("window")) {
+    const double w = r.number(j["window"], "render.window", 2, 32768);
+    const int n = static_cast<int>(w);
+    if (n != w || (n & (n - 1)) != 0) r.fail("render.window", "must be a power of two");
+    s.window = n;
+  }
+  if (j.contains("haze_km")) s.haze_km = r.number(j["haze_km"], "render.haze_km", 0.0, 1e5);
+  if (j.contains("sun_azimuth")) s.sun_azimuth = r.number(j["sun_azimuth"], "render.sun_azimuth", -360.0, 360.0);
+  if (j.contains("sun_elevation")) s.sun_elevation = r.number(j["sun_elevation"], "render.sun_elevation", 1e-3, 90.0);
+  if (j.contains("legend")) s.legend = r.boolean(j["legend"], "render.legend");
+  if (j.contains("surface_triangles")) {
+    s.surface_triangles = static_cast<std::size_t>(r.number(j["surface_triangles"], "render.surface_triangles", 0, 1e8));
+  }
+  return s;
+}
+
+}  // namespace
+
+SceneSpec parse_scene_json(const json& doc, const std::filesystem::path& base, const std::string& source) {
+  const Reader r(source);
+  r.only_keys(doc, "", {"dem", "volumes", "camera", "render"});
+  SceneSpec s;
+  if (doc.contains("dem")) {
+    const json& d = doc["dem"];
+    if (d.is_string()) {
+      s.dems.push_back(resolve(base, r.string(d, "dem")));
+    } else if (d.is_array()) {
+      for (std::size_t k = 0; k < d.size(); ++k) s.dems.push_back(resolve(base, r.string(d[k], Reader::at("dem", k))));
+    } else {
+      r.fail("dem", "expected a path or a list of paths");
+    }
+  }
+  if (doc.contains("volumes")) {
+    if (!doc["volumes"].is_array()) r.fail("volumes", "expected a list");
+    for (std::size_t k = 0; k < doc["volumes"].size(); ++k) {
+      s.volumes.push_back(volume_of(r, doc["volumes"][k], Reader::at("volumes", k), base));
+    }
+  }
+  if (doc.contains("camera")) s.camera = camera_of(r, doc["camera"]);
+  if (doc.contains("render")) s.style = style_of(r, doc["render"]);
+  return s;
+}
+
+SceneSpec load_scene_file(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw std::invalid_argument(source + ": cannot read (" + ec.message() + ")");
+  if (size > (16u << 20)) throw std::invalid_argument(source + ": larger than 16 MiB; not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw std::invalid_argument(source + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
+  }
+  return parse_scene_json(doc, path.parent_path(), source);
+}
+
+}  // namespace terravol::app

@@ -1,0 +1,61 @@
+// The scene file (JSON): everything a render shows — DEMs, RF volumes with their isosurfaces
+// and slices, the camera and the render style — in one document (docs/scene-file.md).
+// `terravol render --scene FILE` and `terravol view --scene FILE` read it; command-line
+// options override what it says; relative paths are relative to the file.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/camera.h"
+#include "volume/geometry.h"
+
+namespace terravol::app {
+
+struct VolumeSpec {
+  std::filesystem::path file;
+  std::string field;              // grid or array name; empty: the file's first
+  std::string frame;              // volume::parse_frame text overriding the file's; empty: the file's
+  bool visible = true;
+  std::vector<volume::IsoSpec> isosurfaces;
+  std::vector<volume::SliceSpec> slices;
+};
+
+struct SceneCamera {
+  CameraPose pose;
+  bool agl = false;  // pose.alt is above the ground under the camera
+  double fov_y_deg = 45.0;
+};
+
+// The "render" object: every key optional; what is absent keeps the command's default.
+struct SceneStyle {
+  std::optional<int> width, height;
+  std::optional<double> threshold;
+  std::optional<std::string> lod_metric, order, tint;
+  std::optional<int> window;
+  std::optional<double> haze_km, sun_azimuth, sun_elevation;
+  std::optional<bool> legend;
+  std::optional<std::size_t> surface_triangles;
+};
+
+struct SceneSpec {
+  std::vector<std::filesystem::path> dems;
+  std::vector<VolumeSpec> volumes;
+  std::optional<SceneCamera> camera;
+  SceneStyle style;
+};
+
+// Parses a scene document. `base` resolves relative paths; `source` names the document in
+// errors. Throws std::invalid_argument("SOURCE: KEY.PATH: what is wrong") for unknown keys,
+// wrong types and out-of-range values.
+SceneSpec parse_scene_json(const nlohmann::json& doc, const std::filesystem::path& base, const std::string& source);
+
+// Reads and parses a scene file (at most 16 MiB). Throws std::invalid_argument("PATH: ...")
+// for a missing file, malformed JSON (with the byte offset) and whatever parse_scene_json rejects.
+SceneSpec load_scene_file(const std::filesystem::path& path);
+
+}  // namespace terravol::app

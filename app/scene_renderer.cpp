@@ -1,0 +1,137 @@
+#include "app/scene_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "app/png_output.h"
+#include "app/ground_grid.h"
+
+namespace terravol::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+std::string degrees(double v, char positive, char negative) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4f %c", std::abs(v), v < 0 ? negative : positive);
+  return b;
+}
+
+}  // namespace
+
+SceneRenderer::SceneRenderer(const SceneSpec& scene, const RenderSettings& settings, int max_window, int levels,
+                             const ShadingOptions& shading, bool legend, std::size_t surface_triangles)
+    : mosaic_(io::Mosaic::open(scene.dems)), settings_(settings), shading_(shading), legend_(legend) {
+  const io::Georef& g = mosaic_.georef();
+  double row = (mosaic_.rows() - 1) / 2.0, col = (mosaic_.cols() - 1) / 2.0;
+  if (scene.camera) check_inside(scene.camera->pose);
+  require_x_display();
+  if (scene.camera) {
+    row = (g.y0 - scene.camera->pose.lat) / g.dy;
+    col = (std::remainder(scene.camera->pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
+  }
+  const WindowChoice window = choose_window(mosaic_.rows(), mosaic_.cols(), row, col, max_window);
+  levels_ = levels > 0 ? levels : default_levels(window.cells);
+  scene_ = std::make_unique<TerrainScene>(mosaic_, window, levels_);
+
+  // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
+  volumes_ = VolumeLayer(scene.volumes, mosaic_, scene_->frame(), surface_triangles);
+  volumes_.merge_into(*scene_);
+  lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
+  const TerrainShading shading_all =
+      vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  renderer_ = std::make_unique<TerrainRenderer>(scene_->tree().positions(), shading_all, settings_,
+                                                ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  if (legend_) renderer_->set_legend(volumes_.legend());
+}
+
+SceneRenderer::~SceneRenderer() = default;
+
+void SceneRenderer::check_inside(const CameraPose& pose) const {
+  const io::Georef& g = mosaic_.georef();
+  const double row = (g.y0 - pose.lat) / g.dy;
+  const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
+  if (row < 0 || row > mosaic_.rows() - 1 || col < 0 || col > mosaic_.cols() - 1) {
+    const double south = g.y0 - (mosaic_.rows() - 1) * g.dy, east = g.x0 + (mosaic_.cols() - 1) * g.dx;
+    throw std::runtime_error("camera " + degrees(pose.lat, 'N', 'S') + ", " + degrees(pose.lon, 'E', 'W') +
+                             " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
+                             ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
+  }
+}
+
+void SceneRenderer::upload_vertices() {
+  const TerrainShading all = vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  renderer_->replace_vertices(scene_->tree().positions(), all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+}
+
+FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_deg,
+                                 const mrbsp::TraversalOptions& traversal) {
+  check_inside(pose);
+  FrameStats stats;
+  // Slide when the camera nears the window's edge, by whole coarsest-level cells.
+  const io::Georef& g = mosaic_.georef();
+  const double row = (g.y0 - pose.lat) / g.dy;
+  const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
+  const int step = 1 << (levels_ - 1);
+  const WindowChoice next = plan_slide(scene_->window(), mosaic_.rows(), mosaic_.cols(), row, col, step);
+  if (next.row0 != scene_->window().row0 || next.col0 != scene_->window().col0) {
+    const auto t0 = Clock::now();
+    scene_->slide(mosaic_, next);  // merges the volumes' polygons again into the moved window
+    lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
+    upload_vertices();
+    ++slides_;
+    stats.slide_ms = ms_since(t0);
+  }
+  stats.slides = slides_;
+
+  stats.ground_height = ground_height(pose.lat, pose.lon);
+  stats.eye_height = agl ? stats.ground_height + pose.alt : pose.alt;
+  const double clearance = stats.eye_height - stats.ground_height;
+  if (!(clearance > 0.0)) {
+    char b[160];
+    std::snprintf(b, sizeof b, "camera at %.1f m is not above the ground (%.1f m there)%s", stats.eye_height,
+                  stats.ground_height, agl ? "" : "; use --agl for heights above ground");
+    throw std::runtime_error(b);
+  }
+  const RenderSettings& s = renderer_->settings();
+  camera_ = make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, s.width, s.height,
+                              near_plane_for(clearance));
+  renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
+  if (s.gradient) {
+    const auto sky = sky_gradient(pose.pitch_deg, fov_y_deg);
+    renderer_->set_background(sky[0], sky[1]);
+  }
+
+  auto t0 = Clock::now();
+  scene_->tree().traverse(camera_, traversal, frame_);
+  stats.traversal_ms = ms_since(t0);
+  t0 = Clock::now();
+  renderer_->set_frame(frame_);
+  stats.upload_ms = ms_since(t0);
+  stats.draw_ms = renderer_->render();
+  stats.triangles = frame_.indices.size() / 3;
+  stats.merged_triangles = static_cast<std::size_t>(
+      std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kMergedLevel)));
+  stats.nodes_visited = frame_.nodes_visited;
+  return stats;
+}
+
+std::vector<std::uint8_t> SceneRenderer::rgb() const { return window_rgb(renderer_->window()); }
+std::vector<std::uint8_t> SceneRenderer::png() const { return renderer_->png(); }
+
+double SceneRenderer::ground_height(double lat, double lon) const {
+  const WindowBounds b = scene_->bounds();
+  if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
+  const io::Georef& g = mosaic_.georef();
+  return GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
+}
+
+}  // namespace terravol::app

@@ -1,0 +1,186 @@
+#include "app/volume_layer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "app/ground_grid.h"
+#include "volume/colormap.h"
+#include "volume/geometry.h"
+#include "volume/readers.h"
+
+namespace terravol::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+std::array<float, 2> finite_range(const volume::Volume& v) {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (float x : v.values) {
+    if (std::isfinite(x)) {
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+  }
+  if (!(lo <= hi)) return {0.0f, 1.0f};
+  return {lo, hi};
+}
+
+}  // namespace
+
+// A volume as read, the ground under it, its mapper into the scene frame, and the geometry
+// of each style.
+struct VolumeLayer::Loaded {
+  VolumeSpec spec;
+  volume::Volume data;
+  GroundGrid ground;
+  std::unique_ptr<volume::LatticeMapper> mapper;
+  std::vector<volume::Mesh> isosurfaces, slices;
+  std::array<float, 2> range{0, 1};
+
+  volume::GroundFunction ground_function() const {
+    return [this](double lat, double lon) { return ground(lat, lon); };
+  }
+  std::size_t max_triangles = 0;
+
+  volume::Mesh iso_mesh(const volume::IsoSpec& s) const {
+    return volume::decimate(volume::isosurface(data, *mapper, s.value, s.rgba()), max_triangles);
+  }
+  volume::Mesh slice_mesh(const volume::SliceSpec& s) const {
+    try {
+      return volume::decimate(volume::slice(data, *mapper, s, ground_function()), max_triangles);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(spec.file.string() + ": " + e.what());
+    }
+  }
+};
+
+VolumeLayer::VolumeLayer() = default;
+VolumeLayer::~VolumeLayer() = default;
+VolumeLayer::VolumeLayer(VolumeLayer&&) noexcept = default;
+VolumeLayer& VolumeLayer::operator=(VolumeLayer&&) noexcept = default;
+
+VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
+                         std::size_t max_triangles)
+    : max_triangles_(max_triangles) {
+  const auto t0 = Clock::now();
+  for (const VolumeSpec& spec : specs) {
+    auto v = std::make_unique<Loaded>();
+    v->spec = spec;
+    v->max_triangles = max_triangles_;
+    volume::ReadOptions read;
+    read.field = spec.field;
+    if (!spec.frame.empty()) read.frame = volume::parse_frame(spec.frame);
+    v->data = volume::read_volume(spec.file, read);
+    if (v->data.frame.kind == volume::FrameKind::kNone) {
+      throw std::invalid_argument(spec.file.string() +
+                                  ": the volume does not say where it lies; give its frame (geographic, "
+                                  "geographic-agl or enu:LAT,LON,H)");
+    }
+    // Its footprint, for the ground under it: the lattice's corners, geodetic (heights do not
+    // move them).
+    const volume::LatticeMapper flat(v->data, frame, [](double, double) { return 0.0; });
+    const volume::Lattice& l = v->data.lattice;
+    double south = 90, north = -90, west = 1e9, east = -1e9;
+    for (int c = 0; c < 4; ++c) {
+      const io::Geodetic p = flat.geodetic((c & 1) ? l.dims[0] - 1 : 0, (c & 2) ? l.dims[1] - 1 : 0, 0);
+      south = std::min(south, p.lat);
+      north = std::max(north, p.lat);
+      west = std::min(west, p.lon);
+      east = std::max(east, p.lon);
+    }
+    v->ground = GroundGrid(mosaic, south, north, west, east);
+    v->mapper = std::make_unique<volume::LatticeMapper>(v->data, frame, v->ground_function());
+    v->range = finite_range(v->data);
+    for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
+    for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
+    volumes_.push_back(std::move(v));
+  }
+  figures_.geometry_ms = ms_since(t0);
+}
+
+const VolumeSpec& VolumeLayer::spec(std::size_t volume) const {
+  if (volume >= volumes_.size()) throw std::invalid_argument("there is no volume " + std::to_string(volume + 1));
+  return volumes_[volume]->spec;
+}
+
+void VolumeLayer::merge_into(TerrainScene& scene) {
+  volume::Mesh all;
+  for (const auto& v : volumes_) {
+    if (!v->spec.visible) continue;
+    for (const auto& m : v->isosurfaces) volume::append(all, m);
+    for (const auto& m : v->slices) volume::append(all, m);
+  }
+  const auto t0 = Clock::now();
+  const mrbsp::MergeStats stats = scene.merge(all.vertices, all.colors, all.triangles);
+  figures_.merge_ms = ms_since(t0);
+  figures_.input_triangles = all.triangle_count();
+  figures_.tree_triangles = stats.stored_polygons;
+}
+
+void VolumeLayer::set_visible(std::size_t volume, bool visible) {
+  spec(volume);
+  volumes_[volume]->spec.visible = visible;
+}
+
+void VolumeLayer::set_slice(std::size_t volume, std::size_t slice, const volume::SliceSpec& s) {
+  spec(volume);
+  Loaded& v = *volumes_[volume];
+  if (slice >= v.slices.size()) {
+    throw std::invalid_argument("volume " + std::to_string(volume + 1) + " has no slice " + std::to_string(slice + 1));
+  }
+  const auto t0 = Clock::now();
+  v.slices[slice] = v.slice_mesh(s);
+  v.spec.slices[slice] = s;
+  figures_.geometry_ms = ms_since(t0);
+}
+
+void VolumeLayer::set_isosurface(std::size_t volume, std::size_t iso, const volume::IsoSpec& s) {
+  spec(volume);
+  Loaded& v = *volumes_[volume];
+  if (iso >= v.isosurfaces.size()) {
+    throw std::invalid_argument("volume " + std::to_string(volume + 1) + " has no isosurface " + std::to_string(iso + 1));
+  }
+  const auto t0 = Clock::now();
+  v.isosurfaces[iso] = v.iso_mesh(s);
+  v.spec.isosurfaces[iso] = s;
+  figures_.geometry_ms = ms_since(t0);
+}
+
+TerrainRenderer::Legend VolumeLayer::legend() const {
+  TerrainRenderer::Legend legend;
+  for (const auto& v : volumes_) {
+    if (!v->spec.visible || (v->spec.slices.empty() && v->spec.isosurfaces.empty())) continue;
+    const std::string units = v->data.units.empty() ? "" : " (" + v->data.units + ")";
+    legend.title = v->data.name + units;
+    if (!v->spec.slices.empty()) {
+      const volume::SliceSpec& s = v->spec.slices.front();
+      legend.lo = s.lo.value_or(v->range[0]);
+      legend.hi = s.hi.value_or(v->range[1]);
+      const volume::Colormap map = volume::colormap_by_name(s.colormap);
+      for (int k = 0; k < 64; ++k) {
+        const glm::u8vec3 c = map.map(k / 63.0);
+        legend.colors.push_back({c.r, c.g, c.b});
+      }
+    } else {
+      for (const auto& iso : v->spec.isosurfaces) {
+        char b[48];
+        std::snprintf(b, sizeof b, "%g %s", static_cast<double>(iso.value), v->data.units.c_str());
+        legend.labels.push_back(b);
+        legend.colors.push_back({iso.color.r, iso.color.g, iso.color.b});
+      }
+    }
+    break;
+  }
+  return legend;
+}
+
+}  // namespace terravol::app

@@ -1,0 +1,242 @@
+// `terravol fly` as a user runs it: PNG frames and video over the bundled DEM, interrupting
+// and resuming, refusing to overwrite, and bad path files failing before any frame.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image_compare.h"
+#include "require_display.h"
+#include "run_command.h"
+#include "temp_dir.h"
+
+namespace terravol {
+namespace {
+
+using nlohmann::json;
+using test::run_terravol;
+
+std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A 4 s flight 700-900 m above the ground over the bundled DEM, about 9 km north-east, in a
+// 64-cell window so that the window slides several times on the way.
+json flight(double seconds = 4.0) {
+  json keys = json::array();
+  keys.push_back({{"t", 0}, {"lat", 45.10}, {"lon", 6.30}, {"alt", 900}, {"agl", true}, {"heading", 40}, {"pitch", -12}});
+  keys.push_back({{"t", seconds / 2}, {"lat", 45.13}, {"lon", 6.36}, {"alt", 700}, {"agl", true}, {"heading", 60}, {"pitch", -8}});
+  keys.push_back({{"t", seconds}, {"lat", 45.16}, {"lon", 6.40}, {"alt", 800}, {"agl", true}, {"heading", 20}, {"pitch", -15}});
+  return {{"scene", {{"dem", bundled_dem()}, {"render", {{"window", 64}}}}}, {"keys", keys}};
+}
+
+std::filesystem::path write_path(const test::TempDir& dir, const json& doc, const std::string& name = "path.json") {
+  const auto p = dir.path() / name;
+  std::ofstream(p) << doc.dump(2);
+  return p;
+}
+
+std::vector<std::string> pngs(const std::filesystem::path& folder) {
+  std::vector<std::string> names;
+  if (!std::filesystem::is_directory(folder)) return names;
+  for (const auto& e : std::filesystem::directory_iterator(folder)) {
+    if (e.path().extension() == ".png") names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// The last line of a CSV file, split at commas.
+std::vector<std::string> last_row(const std::filesystem::path& csv) {
+  std::istringstream in(slurp(csv));
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  std::vector<std::string> cells;
+  std::istringstream row(last);
+  for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+  return cells;
+}
+
+void expect_same_frames(const std::filesystem::path& a, const std::filesystem::path& b) {
+  const auto names = pngs(a);
+  ASSERT_EQ(names, pngs(b));
+  for (const auto& n : names) EXPECT_TRUE(slurp(a / n) == slurp(b / n)) << n << " differs";
+}
+
+TEST(FlyCli, PngExportWritesEveryFrameOfThePath) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto path = write_path(dir, flight());
+  const auto frames = dir.path() / "frames";
+  const auto stats = dir.path() / "stats.csv";
+  const auto r = run_terravol("fly " + path.string() + " -o " + frames.string() + "/ --fps 10 --size 160x90 --stats " +
+                              stats.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto names = pngs(frames);
+  ASSERT_EQ(names.size(), 41u);  // 0 .. 4 s at 10 fps
+  EXPECT_EQ(names.front(), "frame_000000.png");
+  EXPECT_EQ(names.back(), "frame_000040.png");
+  const auto img = test::read_png(frames / names[20]);
+  EXPECT_EQ(img.width, 160);
+  EXPECT_EQ(img.height, 90);
+  EXPECT_LT(test::color_share(img, img.at(80, 89), 2), 0.5) << "the frame should not be one colour";
+  EXPECT_NE(r.err.find("41/41 frames"), std::string::npos) << r.err;
+  const auto row = last_row(stats);
+  ASSERT_EQ(row.size(), 20u);
+  EXPECT_EQ(row[0], "40");
+  EXPECT_GE(std::stoi(row[18]), 1) << "the path should slide the 64-cell window";
+}
+
+TEST(FlyCli, ResumingAnInterruptedExportGivesTheSameFrames) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto path = write_path(dir, flight());
+  const std::string common = "fly " + path.string() + " --fps 10 --size 160x90 -o ";
+  const auto whole = dir.path() / "whole", parts = dir.path() / "parts";
+  auto r = run_terravol(common + whole.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_terravol(common + parts.string() + " --end 2.25");  // stopped early, after two slides
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(pngs(parts).size(), 23u);
+  std::filesystem::remove(parts / "frame_000022.png");
+  r = run_terravol(common + parts.string() + " --resume");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("(19 frames)"), std::string::npos) << r.out;
+  expect_same_frames(whole, parts);
+}
+
+TEST(FlyCli, KilledExportResumesFromTheFirstMissingFrame) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto path = write_path(dir, flight(12.0));
+  const std::string common = std::string(TERRAVOL_EXE) + " fly " + path.string() + " --fps 10 --size 160x90 -o ";
+  const auto whole = dir.path() / "whole", parts = dir.path() / "parts";
+  // SIGTERM once a few frames are written; the export stops after the frame it is drawing.
+  const std::string script = common + parts.string() + " 2>" + (dir.path() / "err").string() +
+                             " >/dev/null & p=$!; for i in $(seq 600); do n=$(ls " + parts.string() +
+                             " 2>/dev/null | grep -c png); [ \"$n\" -ge 5 ] && break; sleep 0.02; done; kill -TERM $p; wait $p";
+  const int raw = std::system(("timeout 30 sh -c '" + script + "'").c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 1);
+  const std::string err = slurp(dir.path() / "err");
+  EXPECT_NE(err.find("interrupted after frame"), std::string::npos) << err;
+  const std::size_t written = pngs(parts).size();
+  EXPECT_GE(written, 5u);
+  ASSERT_LT(written, 121u) << "the export ended before it was killed";
+  auto r = run_terravol("fly " + path.string() + " --fps 10 --size 160x90 -o " + parts.string() + " --resume");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_terravol("fly " + path.string() + " --fps 10 --size 160x90 -o " + whole.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_frames(whole, parts);
+}
+
+TEST(FlyCli, ExistingFramesAreNotOverwrittenWithoutForce) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto path = write_path(dir, flight(1.0));
+  const auto frames = dir.path() / "frames";
+  const std::string cmd = "fly " + path.string() + " --fps 5 -o " + frames.string() + " --size ";
+  const std::string same = cmd + "64x36";
+  ASSERT_EQ(run_terravol(same).status, 0);
+  auto r = run_terravol(same);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("holds 6 frames of this range (use --resume to continue or --force to overwrite)"),
+            std::string::npos) << r.err;
+  r = run_terravol(same + " --resume");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("all 6 frames present"), std::string::npos) << r.out;
+  r = run_terravol(cmd + "64x38 --resume");  // another size: not the same export
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("made with another size"), std::string::npos) << r.err;
+  EXPECT_EQ(run_terravol(same + " --force").status, 0);
+}
+
+TEST(FlyCli, Mp4HasTheRightFrameCountAndNoTemporaryFileRemains) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  if (std::system("command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null") != 0) {
+    GTEST_SKIP() << "ffmpeg or ffprobe not found";
+  }
+  test::TempDir dir;
+  const auto path = write_path(dir, flight(2.0));
+  const auto mp4 = dir.path() / "flight.mp4";
+  auto r = run_terravol("fly " + path.string() + " --fps 12 --size 160x90 --samples 4 -o " + mp4.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto probe = dir.path() / "probe.txt";
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=codec_name,width,height,nb_read_frames -of csv=p=0 " + mp4.string() + " >" + probe.string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(slurp(probe), "h264,160,90,25\n");
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+  }
+  r = run_terravol("fly " + path.string() + " --fps 12 --size 160x90 -o " + mp4.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("flight.mp4: exists (use --force to overwrite)"), std::string::npos) << r.err;
+}
+
+// Exit status 1, one line on stderr containing `expected`, nothing written.
+void expect_rejected(const test::TempDir& dir, const std::string& path_text, const std::string& expected,
+                     const std::string& extra = "", const std::string& out_name = "out") {
+  const auto path = dir.path() / "bad.json";
+  std::ofstream(path) << path_text;
+  const auto out = dir.path() / out_name;
+  const auto r = run_terravol("fly " + path.string() + " -o " + out.string() + " --size 64x36 " + extra);
+  EXPECT_EQ(r.status, 1) << path_text;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out)) << "nothing may be written for " << expected;
+}
+
+TEST(FlyCli, BadPathFilesFailWithOneLineBeforeAnyFrame) {
+  test::TempDir dir;
+  json doc = flight();
+  doc["keys"][1]["heeding"] = 3;
+  expect_rejected(dir, doc.dump(), "bad.json: keys[1].heeding: unknown field");
+  doc = flight();
+  doc["keys"][2]["t"] = 1.0;
+  expect_rejected(dir, doc.dump(), "bad.json: keys[2].t: 1 is not after keys[1].t (2)");
+  doc = flight();
+  doc["keys"][0]["pitch"] = -100;
+  expect_rejected(dir, doc.dump(), "bad.json: keys[0].pitch: must be within [-90, 90], is -100");
+  doc = flight();
+  doc["scene"] = "missing-scene.json";
+  expect_rejected(dir, doc.dump(), "missing-scene.json: cannot read");
+  doc = flight();
+  doc["scene"]["dem"] = "nowhere.hgt";
+  expect_rejected(dir, doc.dump(), "nowhere.hgt: no such file");
+  doc = flight();
+  doc["keys"][0]["roll"] = 10;
+  expect_rejected(dir, doc.dump(), "keys[0].roll: the renderer does not draw a rolled camera yet");
+  expect_rejected(dir, "{\"scene\": ", "bad.json: not valid JSON (byte 11)");
+  expect_rejected(dir, flight().dump(), "--end 9.000: must be within --start .. 4.000 s", "--end 9");
+  expect_rejected(dir, flight().dump(), "--samples 3: must be 1, 4, 9 or 16", "--samples 3");
+  expect_rejected(dir, flight().dump(), "out.avi: not a video", "", "out.avi");
+}
+
+TEST(FlyCli, CameraUnderGroundOrOffTheDemFailsBeforeAnyFrame) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  json doc = flight();
+  doc["keys"][1]["agl"] = false;
+  doc["keys"][1]["alt"] = 200;  // far below the Alps
+  expect_rejected(dir, doc.dump(), "bad.json: at t=");
+  doc = flight();
+  doc["keys"][2]["lat"] = 46.5;  // north of the tile
+  expect_rejected(dir, doc.dump(), "is outside the DEM");
+}
+
+}  // namespace
+}  // namespace terravol

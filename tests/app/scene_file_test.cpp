@@ -1,0 +1,120 @@
+// The scene file: what it may say, how paths resolve, and one-line errors for what it may not.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "app/scene_file.h"
+#include "temp_dir.h"
+
+namespace terravol::app {
+namespace {
+
+using nlohmann::json;
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene_json(json::parse(text), "/base", "scene.json");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SceneFile, TheIssuesExampleParsesWithEveryValue) {
+  const SceneSpec s = parse_scene_json(json::parse(R"({"dem": ["N44W072.hgt"], "volumes": [{"file": "rf.vdb",
+      "isosurfaces": [{"value": 120, "color": [255, 200, 0], "opacity": 0.4}],
+      "slices": [{"agl": 300, "opacity": 0.5, "colormap": "viridis"}]}],
+      "camera": {"lat": 44.2, "lon": -71.4, "alt": 3000, "heading": 45, "pitch": -20, "fov": 45}})"),
+                                       "/data/scenes", "scene.json");
+  ASSERT_EQ(s.dems.size(), 1u);
+  EXPECT_EQ(s.dems[0], std::filesystem::path("/data/scenes/N44W072.hgt")) << "relative to the scene file";
+  ASSERT_EQ(s.volumes.size(), 1u);
+  const VolumeSpec& v = s.volumes[0];
+  EXPECT_EQ(v.file, std::filesystem::path("/data/scenes/rf.vdb"));
+  EXPECT_TRUE(v.visible);
+  ASSERT_EQ(v.isosurfaces.size(), 1u);
+  EXPECT_EQ(v.isosurfaces[0].value, 120.0f);
+  EXPECT_EQ(v.isosurfaces[0].color, glm::u8vec3(255, 200, 0));
+  EXPECT_DOUBLE_EQ(v.isosurfaces[0].opacity, 0.4);
+  ASSERT_EQ(v.slices.size(), 1u);
+  EXPECT_EQ(v.slices[0].kind, volume::SliceKind::kAgl);
+  EXPECT_DOUBLE_EQ(v.slices[0].value, 300.0);
+  EXPECT_EQ(v.slices[0].colormap, "viridis");
+  ASSERT_TRUE(s.camera.has_value());
+  EXPECT_DOUBLE_EQ(s.camera->pose.lat, 44.2);
+  EXPECT_DOUBLE_EQ(s.camera->pose.heading_deg, 45.0);
+  EXPECT_DOUBLE_EQ(s.camera->pose.pitch_deg, -20.0);
+  EXPECT_DOUBLE_EQ(s.camera->fov_y_deg, 45.0);
+  EXPECT_FALSE(s.camera->agl);
+}
+
+TEST(SceneFile, AbsolutePathsStayAndOneDemMayBeAString) {
+  const SceneSpec s = parse_scene_json(json::parse(R"({"dem": "/abs/tiles", "volumes": [{"file": "/abs/a.vdb"}]})"),
+                                       "/base", "scene.json");
+  ASSERT_EQ(s.dems.size(), 1u);
+  EXPECT_EQ(s.dems[0], std::filesystem::path("/abs/tiles"));
+  EXPECT_EQ(s.volumes[0].file, std::filesystem::path("/abs/a.vdb"));
+}
+
+TEST(SceneFile, IsosurfacesWithoutAColourGetDistinctOnes) {
+  const SceneSpec s = parse_scene_json(
+      json::parse(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 100}, {"value": 120}]}]})"), "/b", "s");
+  EXPECT_NE(s.volumes[0].isosurfaces[0].color, s.volumes[0].isosurfaces[1].color);
+  EXPECT_DOUBLE_EQ(s.volumes[0].isosurfaces[0].opacity, 0.5);
+}
+
+TEST(SceneFile, RenderStyleKeysAreRead) {
+  const SceneSpec s = parse_scene_json(json::parse(R"({"render": {"size": "640x360", "threshold": 1.5,
+      "order": "peel", "tint": "grey", "window": 512, "haze_km": 0, "legend": false}})"),
+                                       "/b", "s");
+  EXPECT_EQ(s.style.width, 640);
+  EXPECT_EQ(s.style.height, 360);
+  EXPECT_EQ(s.style.threshold, 1.5);
+  EXPECT_EQ(s.style.order, "peel");
+  EXPECT_EQ(s.style.window, 512);
+  EXPECT_EQ(s.style.legend, false);
+}
+
+TEST(SceneFile, ErrorsNameTheFileAndTheKeyPath) {
+  EXPECT_EQ(error_of(R"({"dem": [], "volumez": []})"),
+            "scene.json: volumez: unknown key (known: dem, volumes, camera, render)");
+  EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "slices": [{"agl": 300}, {"agl": 1, "lat": 2}]}]})"),
+            "scene.json: volumes[0].slices[1]: needs exactly one of lat, lon, alt, agl");
+  EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 1, "opacity": 2}]}]})"),
+            "scene.json: volumes[0].isosurfaces[0].opacity: must be within [0, 1], is 2");
+  EXPECT_EQ(error_of(R"({"camera": {"lat": 44, "lon": -71}})"), "scene.json: camera: missing \"alt\"");
+  EXPECT_EQ(error_of(R"({"camera": {"lat": "44", "lon": -71, "alt": 1}})"), "scene.json: camera.lat: expected a number");
+  EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 1, "color": [1, 2]}]}]})"),
+            "scene.json: volumes[0].isosurfaces[0].color: expected [R, G, B] with each 0..255");
+  EXPECT_NE(error_of(R"({"volumes": [{"file": "a.vdb", "slices": [{"agl": 1, "colormap": "rainbowz"}]}]})")
+                .find("scene.json: volumes[0].slices[0].colormap: unknown colour map"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"render": {"order": "painter"}})").find("scene.json: render.order: --order painter"),
+            std::string::npos);
+  EXPECT_EQ(error_of(R"({"render": {"window": 300}})"), "scene.json: render.window: must be a power of two");
+  EXPECT_EQ(error_of(R"([1, 2])"), "scene.json: (top level): expected an object");
+}
+
+TEST(SceneFile, FilesThatAreNotScenesFailWithOneLine) {
+  test::TempDir dir;
+  const auto bad = dir.path() / "bad.json";
+  std::ofstream(bad) << "{\"dem\": [\"a.hgt\",";
+  try {
+    load_scene_file(bad);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), bad.string() + ": not valid JSON (byte 18)");
+  }
+  try {
+    load_scene_file(dir.path() / "missing.json");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.json: cannot read"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace terravol::app
