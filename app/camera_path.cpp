@@ -450,7 +450,6 @@ PathSample CameraPath::at(double t) const {
     u = arc_u_[k - 1] + w * (arc_u_[k] - arc_u_[k - 1]);
     tau = std::clamp(time_of_knot(u), start(), end());
   }
-  // Exactly the key at its time (the splines meet it only to rounding).
   const glm::dvec3 p = position(u);
   const std::size_t i = segment_of(times_, tau);
   const double f = std::clamp((tau - times_[i]) / (times_[i + 1] - times_[i]), 0.0, 1.0);

@@ -15,5 +15,6 @@ void add_rf_command(CLI::App& app);          // terravol rf --tx ... --dem DEM..
 void add_fly_command(CLI::App& app);         // terravol fly PATH.json -o out.mp4|frames/
 void add_splat_command(CLI::App& app);       // terravol splat-volume --tx ... --sdf DIR -o out.vdb
 void add_compare_command(CLI::App& app);     // terravol compare-volumes A.vdb B.vdb
+void add_image_diff_command(CLI::App& app);   // terravol compare-images A.png B.png
 
 }  // namespace terravol::app

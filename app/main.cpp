@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   terravol::app::add_fly_command(app);
   terravol::app::add_splat_command(app);
   terravol::app::add_compare_command(app);
+  terravol::app::add_image_diff_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
