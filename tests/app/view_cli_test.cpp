@@ -567,6 +567,44 @@ TEST(ViewCli, EscapeQuitsWithStatusZeroAndATimingSummary) {
   EXPECT_NE(v.stdout_text().find("frames "), std::string::npos) << v.stdout_text();
 }
 
+TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  const auto r = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
+                                    " --radius-km 5 --heights 0:1000:100 -o " + vdb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  Viewer v(bundled_dem() + " --camera 45.44,6.44,2600,40,-18 --volume " + vdb.string() +
+           " --iso 110 --slice agl=300" + kSmall);
+  ASSERT_TRUE(v.start());
+  json s = v.settle();
+  ASSERT_EQ(s["volumes"].size(), 1u);
+  EXPECT_TRUE(s["volumes"][0]["visible"].get<bool>());
+  const auto merged = s["merged_triangles"].get<std::size_t>();
+  EXPECT_GT(merged, 0u);
+
+  v.tap("1");
+  s = v.settle();
+  EXPECT_FALSE(s["volumes"][0]["visible"].get<bool>());
+  EXPECT_EQ(s["merged_triangles"].get<std::size_t>(), 0u) << "a hidden volume is not in the tree";
+  EXPECT_GT(s["last_merge_ms"].get<double>(), 0.0);
+  EXPECT_NE(s["message"].get<std::string>().find("volume 1 hidden"), std::string::npos) << s["message"];
+
+  v.tap("1");
+  v.tap("bracketright");
+  s = v.settle();
+  EXPECT_TRUE(s["volumes"][0]["visible"].get<bool>());
+  EXPECT_DOUBLE_EQ(s["volumes"][0]["slices"][0]["value"].get<double>(), 350.0);
+  EXPECT_NE(s["message"].get<std::string>().find(" ms"), std::string::npos) << s["message"];
+
+  v.tap("period");
+  s = v.settle();
+  EXPECT_DOUBLE_EQ(s["volumes"][0]["isovalues"][0].get<double>(), 112.0);
+  EXPECT_GT(s["merged_triangles"].get<std::size_t>(), 0u);
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+}
+
 TEST(ViewCli, HelpListsTheKeyBindings) {
   const auto r = test::run_terravol("view --help");
   ASSERT_EQ(r.status, 0) << r.err;
