@@ -39,6 +39,9 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--slice", raw->slices,
                   "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume; repeatable");
   cmd->add_flag("--no-legend", raw->no_legend, "No colour legend for the volumes");
+  cmd->add_option("--record", o.record,
+                  "Where key J saves the keyframes recorded with key K, as a camera path for terravol fly "
+                  "(default terravol-path.json here; replaced each time)");
   auto* camera = cmd->add_option("--camera", raw->camera,
                   "LAT,LON,ALT,HEADING,PITCH: degrees, metres (in the DEM's datum; above ground with --agl), "
                   "heading clockwise from north, pitch above the horizon (default: 1500 m above the "
@@ -71,6 +74,7 @@ void add_view_command(CLI::App& app) {
     // The scene file first; whatever the command line gave wins.
     SceneSpec file;
     if (!raw->scene.empty()) file = load_scene_file(raw->scene);
+    opt.scene_file = raw->scene;
     const SceneStyle& st = file.style;
     if (opt.dems.empty()) opt.dems = file.dems;
     if (opt.dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");

@@ -43,6 +43,7 @@
 #include <string>
 #include <utility>
 
+#include "app/camera_path.h"
 #include "app/png_output.h"
 #include "app/terrain_renderer.h"
 #include "app/terrain_scene.h"
@@ -69,6 +70,7 @@ const char* const kViewKeys =
     "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
     ", / .        lower / raise its first isosurface's level by 2 units\n"
     "P            screenshot (PNG)\n"
+    "K / J        record a keyframe of the camera / save the keyframes as a camera path\n"
     "Home         back to the starting pose\n"
     "H            show or hide this list\n"
     "Esc or Q     quit";
@@ -167,6 +169,8 @@ class Viewer {
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void clamp_to_mosaic(CameraPose& p) const;
   void volume_key(const std::string& key);
+  void record_key();
+  void save_path();
   void upload_vertices();
 
   ViewOptions o_;
@@ -175,6 +179,8 @@ class Viewer {
   TerrainShading lattice_;    // the window's lattice shading (its colours are the texture)
   VolumeLayer volumes_;
   std::size_t selected_volume_ = 0;
+  std::vector<PathKey> keys_;  // recorded keyframes (K), saved by J
+  Clock::time_point first_key_time_;
   double last_merge_ms_ = 0;  // the last interactive change of a volume, extraction to upload
   std::future<PreparedSlide> pending_slide_;  // destroyed (waited for) before the mosaic
   std::unique_ptr<TerrainRenderer> renderer_;
@@ -495,6 +501,10 @@ void Viewer::key_press(const std::string& key) {
     auto_slide_ = !auto_slide_;
   } else if (key == "p") {
     screenshot_pending_ = true;
+  } else if (key == "k") {
+    record_key();
+  } else if (key == "j") {
+    save_path();
   } else if (key == "h") {
     help_ = !help_;
     help_text_->SetVisibility(help_);
@@ -639,6 +649,50 @@ void Viewer::volume_key(const std::string& key) {
   std::snprintf(b, sizeof b, "%s: %.0f ms (geometry %.0f, merge %.0f)", what.c_str(), last_merge_ms_, geometry_ms,
                 volumes_.figures().merge_ms);
   message_ = b;
+}
+
+// Keyframes at the times they were recorded, so that the path replays the flight's pace.
+void Viewer::record_key() {
+  const Clock::time_point now = Clock::now();
+  if (keys_.empty()) first_key_time_ = now;
+  PathKey k;
+  k.t = std::chrono::duration<double>(now - first_key_time_).count();
+  if (!keys_.empty()) k.t = std::max(k.t, keys_.back().t + kMinKeyGap);
+  k.lat = pose_.lat;
+  k.lon = pose_.lon;
+  k.alt = pose_.alt;  // above the datum
+  k.heading_deg = pose_.heading_deg;
+  k.pitch_deg = pose_.pitch_deg;
+  k.fov_y_deg = o_.fov_y_deg;
+  k.threshold = threshold();
+  keys_.push_back(k);
+  char b[96];
+  std::snprintf(b, sizeof b, "keyframe %zu at %.1f s (J saves the path)", keys_.size(), k.t);
+  message_ = b;
+}
+
+void Viewer::save_path() {
+  if (keys_.size() < 2) {
+    message_ = "record at least two keyframes (K) before saving";
+    return;
+  }
+  // The scene: the --scene file (absolute), else the DEMs.
+  nlohmann::json scene;
+  if (!o_.scene_file.empty()) {
+    scene = std::filesystem::absolute(o_.scene_file).string();
+  } else {
+    scene = nlohmann::json::object();
+    scene["dem"] = nlohmann::json::array();
+    for (const auto& d : o_.dems) scene["dem"].push_back(std::filesystem::absolute(d).string());
+  }
+  const std::filesystem::path out = o_.record.empty() ? std::filesystem::path("terravol-path.json") : o_.record;
+  try {
+    const std::string text = path_to_json(scene, keys_).dump(2) + "\n";
+    write_file_atomically(out, std::vector<std::uint8_t>(text.begin(), text.end()), true);
+    message_ = "saved " + std::to_string(keys_.size()) + " keyframes to " + out.string();
+  } catch (const std::exception& e) {
+    message_ = std::string("saving the path failed: ") + e.what();
+  }
 }
 
 void Viewer::upload_vertices() {

@@ -34,6 +34,10 @@ struct ViewOptions {
   // name and renamed); empty: none.
   std::filesystem::path status;
   std::vector<VolumeSpec> volumes;  // RF volumes and their styles
+  std::filesystem::path scene_file;  // the --scene file, if any (a recorded path refers to it)
+  // Where the save-path key writes the recorded keyframes (a camera path for terravol fly,
+  // atomically, replaced each time); empty: terravol-path.json in the current folder.
+  std::filesystem::path record;
   bool legend = true;               // a colour legend when volumes are drawn
   // Where the screenshot key writes (replaced each time, atomically); empty: the next free
   // terravol-view-NNN.png in the current folder.

@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/camera_path.h"
 #include "image_compare.h"
 #include "require_display.h"
 #include "run_command.h"
@@ -601,6 +602,29 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
   s = v.settle();
   EXPECT_DOUBLE_EQ(s["volumes"][0]["isovalues"][0].get<double>(), 112.0);
   EXPECT_GT(s["merged_triangles"].get<std::size_t>(), 0u);
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+}
+
+TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto path = dir.path() / "flight.json";
+  Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,0,-10 --record " + path.string() + kSmall);
+  ASSERT_TRUE(v.start());
+  v.settle();
+  v.tap("k");
+  ASSERT_TRUE(v.hold_until("Right", [](const json& s) { return s["camera"]["heading"].get<double>() > 20.0; }, 10.0));
+  v.tap("k");
+  const json before = v.settle();
+  v.tap("j");
+  const json s = v.settle();
+  EXPECT_NE(s["message"].get<std::string>().find("saved 2 keyframes"), std::string::npos) << s["message"];
+  const app::CameraPathFile loaded = app::load_camera_path(path);
+  ASSERT_EQ(loaded.keys.size(), 2u);
+  EXPECT_DOUBLE_EQ(loaded.keys[0].heading_deg, 0.0);
+  EXPECT_NEAR(loaded.keys[1].heading_deg, before["camera"]["heading"].get<double>(), 1e-9);
+  EXPECT_GT(loaded.keys[1].t, loaded.keys[0].t);
   v.xdo("key q");
   EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
