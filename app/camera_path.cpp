@@ -8,6 +8,8 @@
 // is continuous at keys spaced unevenly in time (squad itself assumes equal spacing).
 #include "app/camera_path.h"
 
+#include "app/json_reader.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,64 +30,16 @@ using nlohmann::json;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
-std::string format(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
-
 // Errors name the document and the field, e.g. "path.json: keys[2].pitch: ...".
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw std::invalid_argument(source_ + ": " + where + ": " + what);
-  }
-
-  void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> allowed) const {
-    if (!j.is_object()) fail(where, "expected an object");
-    const std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& [key, value] : j.items()) {
-      if (ok.count(key) == 0) {
-        std::string list;
-        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
-        fail(join(where, key), "unknown field (known: " + list + ")");
-      }
-    }
-  }
-
-  const json& required(const json& j, const std::string& where, const char* key) const {
-    if (!j.contains(key)) fail(where, std::string("missing \"") + key + "\"");
-    return j[key];
-  }
-
-  double number(const json& j, const std::string& where, double lo, double hi) const {
-    if (!j.is_number()) fail(where, "expected a number, got " + j.dump());
-    const double v = j.get<double>();
-    if (!std::isfinite(v) || v < lo || v > hi) {
-      fail(where, "must be within [" + format(lo) + ", " + format(hi) + "], is " + format(v));
-    }
-    return v;
-  }
-  bool boolean(const json& j, const std::string& where) const {
-    if (!j.is_boolean()) fail(where, "expected true or false, got " + j.dump());
-    return j.get<bool>();
-  }
-
-  static std::string join(const std::string& where, const std::string& key) {
-    return where.empty() ? key : where + "." + key;
-  }
-
- private:
-  std::string source_;
+struct Reader : JsonReader {
+  explicit Reader(std::string source) : JsonReader(std::move(source), "field") {}
 };
 
 double altitude(const Reader& r, const json& j, const std::string& where, bool agl) {
   // Above the ground: strictly positive; in the datum: from below the Dead Sea to orbit.
   if (agl) {
     const double v = r.number(j, where, 0.0, 1e6);
-    if (!(v > 0.0)) r.fail(where, "must be above the ground (> 0 with agl), is " + format(v));
+    if (!(v > 0.0)) r.fail(where, "must be above the ground (> 0 with agl), is " + format_number(v));
     return v;
   }
   return r.number(j, where, -500.0, 1e6);
@@ -135,12 +89,12 @@ void check_order(const std::vector<PathKey>& keys, const Name& name, const std::
   for (std::size_t i = 1; i < keys.size(); ++i) {
     const double t = keys[i].t, before = keys[i - 1].t;
     if (!(t > before)) {
-      throw std::invalid_argument(prefix + name(i) + ".t: " + format(t) + " is not after " + name(i - 1) + ".t (" +
-                                  format(before) + "); keys must be in time order");
+      throw std::invalid_argument(prefix + name(i) + ".t: " + format_number(t) + " is not after " + name(i - 1) + ".t (" +
+                                  format_number(before) + "); keys must be in time order");
     }
     if (t - before < kMinKeyGap) {
-      throw std::invalid_argument(prefix + name(i) + ".t: " + format(t) + " is within " + format(kMinKeyGap) +
-                                  " s of " + name(i - 1) + ".t (" + format(before) + "); keys too close");
+      throw std::invalid_argument(prefix + name(i) + ".t: " + format_number(t) + " is within " + format_number(kMinKeyGap) +
+                                  " s of " + name(i - 1) + ".t (" + format_number(before) + "); keys too close");
     }
   }
 }

@@ -8,6 +8,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "app/json_reader.h"
 #include "app/render_options.h"
 #include "volume/colormap.h"
 
@@ -17,57 +18,7 @@ namespace {
 
 using nlohmann::json;
 
-// Errors name the document and the key's path, e.g. "scene.json: volumes[0].slices[1].agl: ...".
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw std::invalid_argument(source_ + ": " + where + ": " + what);
-  }
-
-  void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> allowed) const {
-    if (!j.is_object()) fail(where.empty() ? "(top level)" : where, "expected an object");
-    const std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& [key, value] : j.items()) {
-      if (ok.count(key) == 0) {
-        std::string list;
-        for (const char* k : allowed) list += std::string(list.empty() ? "" : ", ") + k;
-        fail(join(where, key), "unknown key (known: " + list + ")");
-      }
-    }
-  }
-
-  double number(const json& j, const std::string& where, double lo, double hi) const {
-    if (!j.is_number()) fail(where, "expected a number");
-    const double v = j.get<double>();
-    if (!std::isfinite(v) || v < lo || v > hi) {
-      fail(where, "must be within [" + format(lo) + ", " + format(hi) + "], is " + format(v));
-    }
-    return v;
-  }
-  bool boolean(const json& j, const std::string& where) const {
-    if (!j.is_boolean()) fail(where, "expected true or false");
-    return j.get<bool>();
-  }
-  std::string string(const json& j, const std::string& where) const {
-    if (!j.is_string() || j.get<std::string>().empty()) fail(where, "expected a non-empty string");
-    return j.get<std::string>();
-  }
-
-  static std::string join(const std::string& where, const std::string& key) {
-    return where.empty() ? key : where + "." + key;
-  }
-  static std::string at(const std::string& where, std::size_t k) { return where + "[" + std::to_string(k) + "]"; }
-
- private:
-  static std::string format(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", v);
-    return b;
-  }
-  std::string source_;
-};
+using Reader = JsonReader;
 
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& text) {
   const std::filesystem::path p(text);
@@ -161,9 +112,7 @@ VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, c
 SceneCamera camera_of(const Reader& r, const json& j) {
   r.only_keys(j, "camera", {"lat", "lon", "alt", "agl", "heading", "pitch", "fov"});
   SceneCamera c;
-  for (const char* key : {"lat", "lon", "alt"}) {
-    if (!j.contains(key)) r.fail("camera", std::string("missing \"") + key + "\"");
-  }
+  for (const char* key : {"lat", "lon", "alt"}) r.required(j, "camera", key);
   c.pose.lat = r.number(j["lat"], "camera.lat", -85.0, 85.0);
   c.pose.lon = r.number(j["lon"], "camera.lon", -360.0, 360.0);
   c.pose.alt = r.number(j["alt"], "camera.alt", -500.0, 1e6);
@@ -221,7 +170,7 @@ SceneStyle style_of(const Reader& r, const json& j) {
 }  // namespace
 
 SceneSpec parse_scene_json(const json& doc, const std::filesystem::path& base, const std::string& source) {
-  const Reader r(source);
+  const Reader r(source, "key");
   r.only_keys(doc, "", {"dem", "volumes", "camera", "render"});
   SceneSpec s;
   if (doc.contains("dem")) {

@@ -86,7 +86,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheKeyPath) {
   EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 1, "opacity": 2}]}]})"),
             "scene.json: volumes[0].isosurfaces[0].opacity: must be within [0, 1], is 2");
   EXPECT_EQ(error_of(R"({"camera": {"lat": 44, "lon": -71}})"), "scene.json: camera: missing \"alt\"");
-  EXPECT_EQ(error_of(R"({"camera": {"lat": "44", "lon": -71, "alt": 1}})"), "scene.json: camera.lat: expected a number");
+  EXPECT_EQ(error_of(R"({"camera": {"lat": "44", "lon": -71, "alt": 1}})"), "scene.json: camera.lat: expected a number, got \"44\"");
   EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 1, "color": [1, 2]}]}]})"),
             "scene.json: volumes[0].isosurfaces[0].color: expected [R, G, B] with each 0..255");
   EXPECT_NE(error_of(R"({"volumes": [{"file": "a.vdb", "slices": [{"agl": 1, "colormap": "rainbowz"}]}]})")
