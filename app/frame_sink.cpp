@@ -7,12 +7,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <vtkImageData.h>
-#include <vtkNew.h>
-#include <vtkPNGWriter.h>
-#include <vtkPointData.h>
-#include <vtkUnsignedCharArray.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -212,29 +206,6 @@ std::optional<long> first_missing_frame(const std::filesystem::path& folder, lon
     if (!std::filesystem::is_regular_file(folder / frame_name(i, digits), ec)) return i;
   }
   return std::nullopt;
-}
-
-std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height) {
-  const std::size_t row = static_cast<std::size_t>(width) * 3;
-  if (width <= 0 || height <= 0 || rgb.size() != row * height) {
-    throw std::invalid_argument("encode_png: " + std::to_string(rgb.size()) + " bytes for " + std::to_string(width) +
-                                "x" + std::to_string(height));
-  }
-  vtkNew<vtkImageData> image;
-  image->SetDimensions(width, height, 1);
-  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
-  auto* dst = static_cast<std::uint8_t*>(image->GetScalarPointer());
-  for (int y = 0; y < height; ++y) {  // VTK's rows go bottom up
-    std::copy_n(rgb.data() + static_cast<std::size_t>(height - 1 - y) * row, row, dst + static_cast<std::size_t>(y) * row);
-  }
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetInputData(image);
-  writer->WriteToMemoryOn();
-  writer->Write();
-  vtkUnsignedCharArray* bytes = writer->GetResult();
-  if (bytes == nullptr || bytes->GetNumberOfValues() == 0) throw std::runtime_error("PNG encoding failed");
-  const std::uint8_t* p = bytes->GetPointer(0);
-  return std::vector<std::uint8_t>(p, p + bytes->GetNumberOfValues());
 }
 
 std::vector<std::uint8_t> downsample_box(std::span<const std::uint8_t> rgb, int width, int height, int factor) {

@@ -77,9 +77,6 @@ long existing_frames(const std::filesystem::path& folder, long first, long last,
 // The first frame of [first, last] missing from `folder`; nullopt when all are there.
 std::optional<long> first_missing_frame(const std::filesystem::path& folder, long first, long last, int digits);
 
-// RGB (top row first) encoded as PNG with vtkPNGWriter: the same pixels give the same bytes.
-// Throws std::runtime_error when encoding fails.
-std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height);
 
 // Averages each factor x factor block of an RGB image (width * factor by height * factor
 // pixels) into one pixel, rounding to nearest: supersampling's box filter. factor 1 copies.

@@ -1,10 +1,10 @@
 #include "app/png_output.h"
 
+#include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkRenderWindow.h>
 #include <vtkUnsignedCharArray.h>
-#include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -13,15 +13,21 @@
 
 namespace terravol::app {
 
-std::vector<std::uint8_t> window_png(vtkRenderWindow* window) {
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOff();
-  grab->Update();
+std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height) {
+  const std::size_t row = static_cast<std::size_t>(width) * 3;
+  if (width <= 0 || height <= 0 || rgb.size() != row * height) {
+    throw std::invalid_argument("encode_png: " + std::to_string(rgb.size()) + " bytes for " + std::to_string(width) +
+                                "x" + std::to_string(height));
+  }
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(width, height, 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  auto* dst = static_cast<std::uint8_t*>(image->GetScalarPointer());
+  for (int y = 0; y < height; ++y) {  // VTK's rows go bottom up
+    std::copy_n(rgb.data() + static_cast<std::size_t>(height - 1 - y) * row, row, dst + static_cast<std::size_t>(y) * row);
+  }
   vtkNew<vtkPNGWriter> writer;
-  writer->SetInputConnection(grab->GetOutputPort());
+  writer->SetInputData(image);
   writer->WriteToMemoryOn();
   writer->Write();
   vtkUnsignedCharArray* bytes = writer->GetResult();
@@ -43,6 +49,11 @@ std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window) {
   }
   delete[] pixels;
   return out;
+}
+
+std::vector<std::uint8_t> window_png(vtkRenderWindow* window) {
+  const int* size = window->GetSize();
+  return encode_png(window_rgb(window), size[0], size[1]);
 }
 
 void write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& png, bool overwrite) {

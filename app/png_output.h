@@ -3,11 +3,17 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <vector>
 
 class vtkRenderWindow;
 
 namespace terravol::app {
+
+// RGB (width * height * 3 bytes, top row first) encoded as PNG with vtkPNGWriter, in memory:
+// the same pixels give the same bytes. Throws std::invalid_argument when the size does not
+// match and std::runtime_error when encoding fails.
+std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height);
 
 // The last frame drawn in `window` (its back buffer, RGB, not re-rendered), encoded as PNG
 // (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.

@@ -150,17 +150,12 @@ void add_render_command(CLI::App& app) {
     RenderOptions o;
     std::string camera, size = "1280x720", metric = "error", order = "bsp", background, tint = "atlas";
     double threshold = 0.0;  // when --threshold is not given: the metric's default
-    std::filesystem::path scene;
-    std::vector<std::filesystem::path> volumes;
-    std::vector<std::string> isos, slices;
-    std::string volume_frame, field;
-    bool no_legend = false;
+    SceneArgs scene;
   };
   auto raw = std::make_shared<Raw>();
   RenderOptions& o = raw->o;
   cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic); default: the scene file's");
-  cmd->add_option("--scene", raw->scene,
-                  "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
+  add_scene_options(*cmd, raw->scene);
   auto* camera = cmd->add_option("--camera", raw->camera,
                   "LAT,LON,ALT,HEADING,PITCH: degrees, metres (in the DEM's datum; above ground with --agl), "
                   "heading clockwise from north, pitch above the horizon");
@@ -194,28 +189,14 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   auto* tint = cmd->add_option("--tint", raw->tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
       ->capture_default_str();
-  cmd->add_option("--volume", raw->volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
-  cmd->add_option("--field", raw->field, "The --volume files' grid or array (default: the first)");
-  cmd->add_option("--volume-frame", raw->volume_frame,
-                  "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
-  cmd->add_option("--iso", raw->isos,
-                  "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume (of the scene file's volumes when "
-                  "no --volume is given); repeatable");
-  cmd->add_option("--slice", raw->slices,
-                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
-                  "repeatable");
-  auto* legend = cmd->add_flag("--no-legend", raw->no_legend, "No colour legend for the volumes");
   auto* surface = cmd->add_option("--surface-triangles", o.surface_triangles,
                   "Decimate each isosurface and slice to at most this many triangles before merging (0: keep all)")
       ->capture_default_str();
   cmd->callback([=] {
     RenderOptions& opt = raw->o;
     // The scene file first; whatever the command line gave wins.
-    SceneSpec file;
-    if (!raw->scene.empty()) file = load_scene_file(raw->scene);
+    const SceneSpec file = read_scene_args(raw->scene, opt.dems);
     const SceneStyle& st = file.style;
-    if (opt.dems.empty()) opt.dems = file.dems;
-    if (opt.dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
     if (camera->count() > 0) {
       opt.pose = parse_camera_pose(raw->camera);
     } else if (file.camera) {
@@ -234,9 +215,9 @@ void add_render_command(CLI::App& app) {
     if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
     if (sun_azimuth->count() == 0 && st.sun_azimuth) opt.shading.sun_azimuth_deg = *st.sun_azimuth;
     if (sun_elevation->count() == 0 && st.sun_elevation) opt.shading.sun_elevation_deg = *st.sun_elevation;
-    opt.legend = legend->count() == 0 ? st.legend.value_or(true) : false;
+    opt.legend = !raw->scene.no_legend && st.legend.value_or(true);
     if (surface->count() == 0 && st.surface_triangles) opt.surface_triangles = *st.surface_triangles;
-    opt.volumes = volumes_from_options(file.volumes, raw->volumes, raw->field, raw->volume_frame, raw->isos, raw->slices);
+    opt.volumes = file.volumes;
 
     parse_size(raw->size, opt.render.width, opt.render.height);
     opt.traversal.metric = parse_metric(raw->metric);

@@ -76,10 +76,29 @@ const char* order_name(DrawOrder order) {
   return "?";
 }
 
-std::vector<VolumeSpec> volumes_from_options(std::vector<VolumeSpec> from_file,
-                                             const std::vector<std::filesystem::path>& files, const std::string& field,
-                                             const std::string& frame, const std::vector<std::string>& isos,
-                                             const std::vector<std::string>& slices) {
+void add_scene_options(CLI::App& cmd, SceneArgs& args) {
+  cmd.add_option("--scene", args.scene,
+                 "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
+  cmd.add_option("--volume", args.volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
+  cmd.add_option("--field", args.field, "The --volume files' grid or array (default: the first)");
+  cmd.add_option("--volume-frame", args.volume_frame,
+                 "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
+  cmd.add_option("--iso", args.isos,
+                 "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume (of the scene file's volumes when "
+                 "no --volume is given); repeatable");
+  cmd.add_option("--slice", args.slices,
+                 "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
+                 "repeatable");
+  cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
+}
+
+SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems) {
+  SceneSpec scene;
+  if (!args.scene.empty()) scene = load_scene_file(args.scene);
+  if (dems.empty()) dems = scene.dems;
+  if (dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
+  scene.dems = dems;
+  const std::string& frame = args.volume_frame;
   if (!frame.empty()) {
     try {
       volume::parse_frame(frame);
@@ -88,26 +107,26 @@ std::vector<VolumeSpec> volumes_from_options(std::vector<VolumeSpec> from_file,
     }
   }
   std::vector<volume::IsoSpec> iso_specs;
-  for (std::size_t k = 0; k < isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(isos[k], k));
+  for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
   std::vector<volume::SliceSpec> slice_specs;
-  for (const auto& text : slices) slice_specs.push_back(volume::parse_slice(text));
-  if (files.empty()) {
-    for (VolumeSpec& v : from_file) {
+  for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
+  if (args.volumes.empty()) {
+    for (VolumeSpec& v : scene.volumes) {
       if (!iso_specs.empty()) v.isosurfaces = iso_specs;
       if (!slice_specs.empty()) v.slices = slice_specs;
     }
-    return from_file;
+    return scene;
   }
-  for (const auto& f : files) {
+  for (const auto& f : args.volumes) {
     VolumeSpec v;
     v.file = f;
-    v.field = field;
+    v.field = args.field;
     v.frame = frame;
     v.isosurfaces = iso_specs;
     v.slices = slice_specs;
-    from_file.push_back(std::move(v));
+    scene.volumes.push_back(std::move(v));
   }
-  return from_file;
+  return scene;
 }
 
 Tint parse_tint(std::string_view text) {

@@ -2,6 +2,8 @@
 // std::invalid_argument with a one-line message that names the option and the text.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -36,14 +38,24 @@ struct RenderOptions {
   std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
 };
 
-// The volumes of a render from the scene file's and the command line's: each --volume FILE
-// (read as `field`, placed by `frame` when not empty) gets the --iso and --slice styles; when
-// no --volume is given, non-empty --iso or --slice lists replace the styles of every volume of
-// the scene file. Throws std::invalid_argument for bad --iso, --slice or --volume-frame text.
-std::vector<VolumeSpec> volumes_from_options(std::vector<VolumeSpec> from_file,
-                                             const std::vector<std::filesystem::path>& files, const std::string& field,
-                                             const std::string& frame, const std::vector<std::string>& isos,
-                                             const std::vector<std::string>& slices);
+// The scene options `render` and `view` share: --scene, --volume, --field, --volume-frame,
+// --iso, --slice, --no-legend.
+struct SceneArgs {
+  std::filesystem::path scene;
+  std::vector<std::filesystem::path> volumes;
+  std::vector<std::string> isos, slices;
+  std::string volume_frame, field;
+  bool no_legend = false;
+};
+void add_scene_options(CLI::App& cmd, SceneArgs& args);
+
+// The scene the command line describes: the --scene file (empty without one), its DEMs
+// replaced by `dems` when not empty (else `dems` gets the file's; none at all is an error),
+// and its volumes joined with the --volume files: each --volume FILE (read as --field, placed
+// by --volume-frame) gets the --iso and --slice styles; with no --volume, non-empty --iso or
+// --slice lists replace the styles of every volume of the file. Throws std::invalid_argument
+// for a bad file or bad --iso, --slice or --volume-frame text.
+SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
 
 // "WxH", each 1..16384.
 void parse_size(std::string_view text, int& width, int& height);

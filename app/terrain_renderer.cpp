@@ -241,23 +241,23 @@ vtkNew<vtkCellArray> triangle_cells(const std::vector<std::uint32_t>& indices) {
 
 void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   // The split orders draw the merged triangles with a second actor: the terrain's list keeps
-  // the rest, in the frame's order.
-  std::vector<std::uint32_t> merged;
-  std::vector<std::int8_t> levels(frame.level.begin(), frame.level.end());
+  // the rest, in the frame's order (buffers reused from frame to frame).
   const std::vector<std::uint32_t>* terrain = &frame.indices;
-  std::vector<std::uint32_t> kept;
+  const std::vector<std::int8_t>* levels = &frame.level;
   if (split_orders()) {
-    kept.reserve(frame.indices.size());
-    levels.clear();
+    split_terrain_.clear();
+    split_merged_.clear();
+    split_levels_.clear();
     for (std::size_t t = 0; 3 * t < frame.indices.size(); ++t) {
       const int lv = t < frame.level.size() ? frame.level[t] : mrbsp::kSkirtLevel;
-      auto& to = lv == mrbsp::kMergedLevel ? merged : kept;
+      auto& to = lv == mrbsp::kMergedLevel ? split_merged_ : split_terrain_;
       to.insert(to.end(), frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
                 frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
-      if (lv != mrbsp::kMergedLevel) levels.push_back(static_cast<std::int8_t>(lv));
+      if (lv != mrbsp::kMergedLevel) split_levels_.push_back(static_cast<std::int8_t>(lv));
     }
-    terrain = &kept;
-    merged_poly_->SetPolys(triangle_cells(merged));
+    terrain = &split_terrain_;
+    levels = &split_levels_;
+    merged_poly_->SetPolys(triangle_cells(split_merged_));
     merged_poly_->Modified();
   }
   const auto triangles = static_cast<vtkIdType>(terrain->size() / 3);
@@ -267,7 +267,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   level->SetName("level");
   level->SetNumberOfValues(triangles);
   std::fill_n(level->GetPointer(0), triangles, static_cast<signed char>(mrbsp::kSkirtLevel));
-  std::copy(levels.begin(), levels.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(levels.size()), triangles),
+  std::copy(levels->begin(), levels->begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(levels->size()), triangles),
             level->GetPointer(0));
   poly_->GetCellData()->AddArray(level);
 

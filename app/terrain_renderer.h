@@ -158,6 +158,8 @@ class TerrainRenderer {
   vtkSmartPointer<vtkPolyDataMapper> merged_mapper_;
   vtkNew<vtkActor> merged_actor_;
   vtkSmartPointer<vtkScalarBarActor> legend_;
+  std::vector<std::uint32_t> split_terrain_, split_merged_;  // set_frame's buffers (split orders)
+  std::vector<std::int8_t> split_levels_;
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkRenderWindow> window_;
 };

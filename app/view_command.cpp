@@ -20,25 +20,12 @@ void add_view_command(CLI::App& app) {
     std::string camera, size = "1280x720", metric = "error", tint = "atlas";
     double threshold = 0.0;
     bool no_slide = false;
-    std::filesystem::path scene;
-    std::vector<std::filesystem::path> volumes;
-    std::vector<std::string> isos, slices;
-    std::string volume_frame, field;
-    bool no_legend = false;
+    SceneArgs scene;
   };
   auto raw = std::make_shared<Raw>();
   ViewOptions& o = raw->o;
   cmd->add_option("dems", o.dems, "DEM files or folders of tiles (one mosaic); default: the scene file's");
-  cmd->add_option("--scene", raw->scene,
-                  "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
-  cmd->add_option("--volume", raw->volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
-  cmd->add_option("--field", raw->field, "The --volume files' grid or array (default: the first)");
-  cmd->add_option("--volume-frame", raw->volume_frame,
-                  "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
-  cmd->add_option("--iso", raw->isos, "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume; repeatable");
-  cmd->add_option("--slice", raw->slices,
-                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume; repeatable");
-  cmd->add_flag("--no-legend", raw->no_legend, "No colour legend for the volumes");
+  add_scene_options(*cmd, raw->scene);
   cmd->add_option("--record", o.record,
                   "Where key J saves the keyframes recorded with key K, as a camera path for terravol fly "
                   "(default terravol-path.json here; replaced each time)");
@@ -72,12 +59,9 @@ void add_view_command(CLI::App& app) {
   cmd->callback([=] {
     ViewOptions& opt = raw->o;
     // The scene file first; whatever the command line gave wins.
-    SceneSpec file;
-    if (!raw->scene.empty()) file = load_scene_file(raw->scene);
-    opt.scene_file = raw->scene;
+    const SceneSpec file = read_scene_args(raw->scene, opt.dems);
+    opt.scene_file = raw->scene.scene;
     const SceneStyle& st = file.style;
-    if (opt.dems.empty()) opt.dems = file.dems;
-    if (opt.dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
     if (camera->count() > 0) {
       opt.pose = parse_camera_pose(raw->camera);
     } else if (file.camera) {
@@ -91,8 +75,8 @@ void add_view_command(CLI::App& app) {
     if (threshold->count() == 0 && st.threshold) raw->threshold = *st.threshold;
     if (window->count() == 0 && st.window) opt.max_window = *st.window;
     if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
-    opt.legend = !raw->no_legend && st.legend.value_or(true);
-    opt.volumes = volumes_from_options(file.volumes, raw->volumes, raw->field, raw->volume_frame, raw->isos, raw->slices);
+    opt.legend = !raw->scene.no_legend && st.legend.value_or(true);
+    opt.volumes = file.volumes;
     parse_size(raw->size, opt.width, opt.height);
     opt.traversal.metric = parse_metric(raw->metric);
     opt.shading.tint = parse_tint(raw->tint);

@@ -1,6 +1,7 @@
 // The pieces of `terravol fly` output that need no renderer: frame names, resuming, the box
 // filter, the progress line, and the video sink's temporary file.
 #include "app/frame_sink.h"
+#include "app/png_output.h"
 
 #include <gtest/gtest.h>
 
