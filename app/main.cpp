@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "app/commands.h"
+#include "bench/bench_command.h"
 #include "io/error.h"
 
 int main(int argc, char** argv) {
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   terravol::app::add_splat_command(app);
   terravol::app::add_compare_command(app);
   terravol::app::add_image_diff_command(app);
+  terravol::bench::add_bench_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

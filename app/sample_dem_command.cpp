@@ -1,15 +1,22 @@
 // `terravol sample-dem`: writes the project's own small DEM (data/dem/N45E006.hgt), a
 // deterministic synthetic SRTM3 tile, so the main job runs on a fresh clone without ../shared.
 // Same bytes on every run and machine: integer hashing and values rounded to whole metres.
+// `--tiles RxC` writes a seamless mosaic of R x C such tiles from N45E006 northward and
+// eastward (one noise field over all of them; N45E006 itself is the same bytes), which the
+// scaling benchmark uses (docs/benchmarks.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 
 #include "app/commands.h"
+#include "app/sample_dem.h"
 #include "app/write_file.h"
 #include "io/grid.h"
 #include "io/srtm_write.h"
@@ -37,7 +44,9 @@ double value_noise(double x, double y, std::uint32_t seed) {
   return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
 }
 
-// Ridged multifractal mountains rising from a lake in the south-west corner.
+// Ridged multifractal mountains rising from a lake in the south-west corner of N45E006.
+// (row, col): samples from N45E006's north-west corner, row south, col east; rows north of
+// that tile are negative.
 float sample_height(int row, int col) {
   const double u = col / 1200.0, v = row / 1200.0;
   double amp = 1.0, freq = 4.0, sum = 0.0, norm = 0.0;
@@ -56,25 +65,41 @@ float sample_height(int row, int col) {
 
 }  // namespace
 
+std::vector<std::filesystem::path> write_sample_dem(const std::filesystem::path& dir, int rows, int cols, bool force) {
+  if (rows < 1 || rows > 8 || cols < 1 || cols > 8) throw std::invalid_argument("--tiles: at most 8x8 tiles");
+  std::filesystem::create_directories(dir);
+  std::vector<std::filesystem::path> written;
+  for (int tr = 0; tr < rows; ++tr)
+    for (int tc = 0; tc < cols; ++tc) {
+      io::Grid g;
+      g.allocate(1201, 1201);
+      const int row0 = -1200 * tr, col0 = 1200 * tc;  // neighbours share their edge samples
+      for (int r = 0; r < 1201; ++r)
+        for (int c = 0; c < 1201; ++c) g.heights[g.index(r, c)] = sample_height(row0 + r, col0 + c);
+      // A small void patch, so that void reporting and filling show on the bundled data.
+      for (int r = 300; r < 306; ++r)
+        for (int c = 800; c < 806; ++c) g.mask[g.index(r, c)] = io::Sample::kVoid;
+      const auto path = dir / (io::srtm_tile_name(45 + tr, 6 + tc) + ".hgt");
+      write_file_atomically(path, io::encode_srtm(g), force);
+      written.push_back(path);
+    }
+  return written;
+}
+
 void add_sample_dem_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "sample-dem", "Write the bundled synthetic DEM (an SRTM3 tile, N45E006.hgt) into a folder");
   auto dir = std::make_shared<std::filesystem::path>("data/dem");
   auto force = std::make_shared<bool>(false);
+  auto tiles = std::make_shared<std::pair<int, int>>(1, 1);
   cmd->add_option("-o,--output-dir", *dir, "Folder to write N45E006.hgt into")->capture_default_str();
   cmd->add_flag("--force", *force, "Overwrite an existing file");
-  cmd->callback([dir, force] {
-    io::Grid g;
-    g.allocate(1201, 1201);
-    for (int r = 0; r < 1201; ++r)
-      for (int c = 0; c < 1201; ++c) g.heights[g.index(r, c)] = sample_height(r, c);
-    // A small void patch, so that void reporting and filling show on the bundled data.
-    for (int r = 300; r < 306; ++r)
-      for (int c = 800; c < 806; ++c) g.mask[g.index(r, c)] = io::Sample::kVoid;
-    std::filesystem::create_directories(*dir);
-    const auto path = *dir / (io::srtm_tile_name(45, 6) + ".hgt");
-    write_file_atomically(path, io::encode_srtm(g), *force);
-    std::printf("wrote %s\n", path.string().c_str());
+  cmd->add_option("--tiles", *tiles, "Write a seamless mosaic of ROWSxCOLS tiles from N45E006 north and east (at most 8x8)")
+      ->delimiter('x')
+      ->check(CLI::Range(1, 8));
+  cmd->callback([dir, force, tiles] {
+    for (const auto& path : write_sample_dem(*dir, tiles->first, tiles->second, *force))
+      std::printf("wrote %s\n", path.string().c_str());
   });
 }
 

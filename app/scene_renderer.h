@@ -64,6 +64,18 @@ class SceneRenderer {
   const MergeFigures& merge_figures() const { return volumes_.figures(); }
   std::size_t volume_count() const { return volumes_.size(); }
 
+  // Another renderer over the same tree, vertices, shading and texture, with other settings
+  // (terravol bench draws one traversal in several orders). It is not told of later slides or
+  // merges: make it again after render() reports a slide or after remerge().
+  std::unique_ptr<TerrainRenderer> make_renderer(const RenderSettings& settings) const;
+  // The lattice's shading (per sample, row 0 south): the colours the terrain is drawn in.
+  const TerrainShading& lattice_shading() const { return lattice_; }
+
+  // Interactive changes to the volumes (VolumeLayer::set_slice, ...), then remerge(): merges
+  // every visible volume into the tree again and uploads the vertices (what terravol view
+  // does after a key). Returns what the merge cost.
+  VolumeLayer& volumes() { return volumes_; }
+  const MergeFigures& remerge();
 
  private:
   void upload_vertices();

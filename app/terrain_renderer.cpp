@@ -27,6 +27,7 @@
 #include <vtkUnsignedCharArray.h>
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -190,8 +191,11 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
       // plain render steps blend in the sorted order instead.
       renderer_->SetPass(vtkNew<vtkRenderStepsPass>());
     }
-    renderer_->SetMaximumNumberOfPeels(0);  // no limit
-    renderer_->SetOcclusionRatio(0.0);      // peel until no pixel changes: exact
+    // No limit is INT_MAX, not 0: VTK 9.1's dual depth peeling (what it uses on llvmpipe) takes
+    // 0 literally, peels nothing and blends in draw order. With occlusion ratio 0 it stops when
+    // a peel writes no pixel: exact.
+    renderer_->SetMaximumNumberOfPeels(settings.peels > 0 ? settings.peels : std::numeric_limits<int>::max());
+    renderer_->SetOcclusionRatio(0.0);
   }
   apply_color_mode();
 
@@ -383,7 +387,10 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   if (split_orders()) merged_poly_->SetPolys(vtkNew<vtkCellArray>());
   const auto count = static_cast<vtkIdType>(n);
   auto copy = [count](vtkDataArray* to, const void* from, std::size_t bytes) {
-    to->SetNumberOfTuples(count);  // keeps the allocation when the count is unchanged
+    // Keeps the allocation when the count is unchanged; otherwise frees it first, since
+    // SetNumberOfTuples alone keeps a larger one (the vertex count changes at every slide).
+    if (to->GetSize() != count * to->GetNumberOfComponents()) to->Initialize();
+    to->SetNumberOfTuples(count);
     std::memcpy(to->GetVoidPointer(0), from, bytes);
     to->Modified();
   };
@@ -398,6 +405,28 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   }
   shade_ = shading.shade;
   point_rgba_ = shading.rgba;
+  poly_->Modified();
+  if (split_orders()) merged_poly_->Modified();
+}
+
+void TerrainRenderer::release_vertices() {
+  poly_->SetPolys(vtkNew<vtkCellArray>());
+  poly_->GetCellData()->Initialize();
+  if (split_orders()) merged_poly_->SetPolys(vtkNew<vtkCellArray>());
+  vtkPointData* pd = poly_->GetPointData();
+  for (vtkDataArray* a : {poly_->GetPoints()->GetData(), pd->GetNormals(), pd->GetScalars(), pd->GetTCoords()}) {
+    if (a == nullptr) continue;
+    a->Initialize();  // frees the storage (vtkDataArray::Squeeze would keep it at the count)
+    a->Modified();
+  }
+  poly_->GetPoints()->Modified();
+  std::vector<float>().swap(shade_);
+  std::vector<Rgba>().swap(point_rgba_);
+  // The mappers' vertex and index buffers. The next render() builds them again, as it would
+  // after replace_vertices() anyway; shader programs stay in the window's cache.
+  window_->MakeCurrent();
+  mapper_->ReleaseGraphicsResources(window_);
+  if (merged_mapper_ != nullptr) merged_mapper_->ReleaseGraphicsResources(window_);
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
 }

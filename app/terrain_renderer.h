@@ -37,7 +37,7 @@ enum class DrawOrder : std::uint8_t {
   kZBuffer,  // the same triangles in the same order, vtkPolyDataMapper with the depth test on
   // The references for translucency, all with the terrain opaque and depth-tested and the
   // merged triangles of the same frame in a second, translucent actor:
-  kPeel,  // VTK's depth peeling, no limit on peels, occlusion ratio 0: exact
+  kPeel,  // VTK's depth peeling, occlusion ratio 0; with no limit on peels (the default): exact
   kVtk,   // VTK 9.1's default translucent pass: weighted blended order-independent
           // translucency (McGuire and Bavoil 2013), depth test on
   kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
@@ -48,6 +48,7 @@ using Rgb = std::array<std::uint8_t, 3>;
 struct RenderSettings {
   int width = 1280, height = 720;  // pixels
   DrawOrder order = DrawOrder::kBsp;
+  int peels = 0;  // kPeel: most depth peels, 0 = no limit (exact; ParaView's default is 4)
   bool wireframe = false;
   bool lod_colors = false;              // per-triangle colours from Frame::level
   Rgb background{205, 222, 240};        // uniform, or the bottom of the gradient
@@ -116,6 +117,12 @@ class TerrainRenderer {
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
   void replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
                         const ColorTexture& texture = {});
+  // Frees every vertex array, the triangle lists and their buffers on the GPU (host memory
+  // under Mesa's llvmpipe), keeping the texture. Call it before a slide or merge that will
+  // replace every vertex, so that the old vertices and the tree's merge scratch never hold
+  // memory at the same time. Until replace_vertices() and set_frame(), render() draws only
+  // the background.
+  void release_vertices();
 
   // A colour legend (vtkScalarBarActor) in the lower right, or none when `legend.colors` is
   // empty. Continuous: colours sampled evenly over [lo, hi]; discrete (isosurfaces): one

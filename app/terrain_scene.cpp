@@ -21,14 +21,14 @@ int floor_log2(int v) {
   return k;
 }
 
+}  // namespace
+
 io::SceneFrame centre_frame(const io::Mosaic& mosaic, const WindowChoice& w) {
   const io::Georef& g = mosaic.georef();
   const double lat = g.y0 - (w.row0 + w.cells / 2) * g.dy;
   const double lon = g.x0 + (w.col0 + w.cells / 2) * g.dx;
   return io::SceneFrame(lat, std::remainder(lon, 360.0));
 }
-
-}  // namespace
 
 WindowChoice choose_window(int rows, int cols, double row, double col, int max_cells) {
   const int side = std::min(rows, cols);

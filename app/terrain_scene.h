@@ -59,6 +59,9 @@ struct SceneWindow {
   float min_z = 0, max_z = 0;
 };
 
+// The scene frame a TerrainScene of `window` is placed in: about the window's centre sample.
+io::SceneFrame centre_frame(const io::Mosaic& mosaic, const WindowChoice& window);
+
 // Reads `window` from the mosaic (read_window), fills its voids and the samples no tile covers
 // (fill_voids) and places it in `frame`. Touches nothing but the mosaic (whose tile cache is
 // not thread-safe: one reader at a time). Throws io::FormatError from the mosaic.

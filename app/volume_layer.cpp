@@ -112,13 +112,18 @@ const VolumeSpec& VolumeLayer::spec(std::size_t volume) const {
   return volumes_[volume]->spec;
 }
 
-void VolumeLayer::merge_into(TerrainScene& scene) {
+volume::Mesh VolumeLayer::visible_mesh() const {
   volume::Mesh all;
   for (const auto& v : volumes_) {
     if (!v->spec.visible) continue;
     for (const auto& m : v->isosurfaces) volume::append(all, m);
     for (const auto& m : v->slices) volume::append(all, m);
   }
+  return all;
+}
+
+void VolumeLayer::merge_into(TerrainScene& scene) {
+  const volume::Mesh all = visible_mesh();
   const auto t0 = Clock::now();
   const mrbsp::MergeStats stats = scene.merge(all.vertices, all.colors, all.triangles);
   figures_.merge_ms = ms_since(t0);

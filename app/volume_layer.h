@@ -14,6 +14,7 @@
 #include "app/terrain_scene.h"
 #include "io/mosaic.h"
 #include "io/scene_frame.h"
+#include "volume/geometry.h"
 
 namespace terravol::app {
 
@@ -44,6 +45,9 @@ class VolumeLayer {
   std::size_t size() const { return volumes_.size(); }
   const VolumeSpec& spec(std::size_t volume) const;  // throws std::invalid_argument when out of range
 
+  // The geometry of every visible volume (isosurfaces, then slices, volume by volume), in the
+  // scene frame with per-vertex RGBA: what merge_into() merges.
+  volume::Mesh visible_mesh() const;
   // Merges the geometry of every visible volume into the scene's tree.
   void merge_into(TerrainScene& scene);
   const MergeFigures& figures() const { return figures_; }

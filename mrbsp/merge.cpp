@@ -41,14 +41,20 @@ class Merger {
   }
 
   glm::dvec3 pos(std::uint32_t v) const {
-    return v < m_.merged_base() ? glm::dvec3(m_.positions[v]) : m_.merged_positions[v - m_.merged_base()];
+    return v < m_.merged_base() ? glm::dvec3(m_.positions[v]) : merged_[v - m_.merged_base()];
   }
 
   std::uint32_t add_vertex(const glm::dvec3& p, const glm::u8vec4& c) {
-    m_.merged_positions.push_back(p);
+    merged_.push_back(p);
     m_.merged_colors.push_back(c);
-    m_.positions.emplace_back(p);
-    return m_.merged_base() + static_cast<std::uint32_t>(m_.merged_positions.size() - 1);
+    return m_.merged_base() + static_cast<std::uint32_t>(merged_.size() - 1);
+  }
+
+  // Appends the merged vertices to the tree's positions, as floats, in one allocation of the
+  // exact size (positions holds only the terrain's blocks when the merge starts).
+  void emit_positions() {
+    m_.positions.reserve(m_.positions.size() + merged_.size());
+    for (const glm::dvec3& p : merged_) m_.positions.emplace_back(p);
   }
 
   glm::u8vec4 color(std::uint32_t v) const {
@@ -234,6 +240,7 @@ class Merger {
  private:
   TerrainTree::Impl& m_;
   double eps_ = 0.0;
+  std::vector<glm::dvec3> merged_;  // the merged vertices in double precision, for classifying
   std::vector<std::pair<std::int32_t, Work>> stack_;
   std::unordered_map<std::int32_t, std::vector<std::uint32_t>> coplanar_;
   std::unordered_map<std::int32_t, std::vector<Work>> cell_polys_;
@@ -241,38 +248,69 @@ class Merger {
 
 }  // namespace
 
+namespace {
+
+// Frees a container's storage (clear() keeps it).
+template <class T>
+void release(std::vector<T>& v) {
+  std::vector<T>().swap(v);
+}
+
+// Gives back a container's growth slack: push_back doubles the capacity, so without this a
+// container can hold up to twice what it needs, and keeps that after the next, smaller merge.
+template <class T>
+void fit(std::vector<T>& v) {
+  if (v.capacity() > v.size()) std::vector<T>(v.begin(), v.end()).swap(v);
+}
+
+}  // namespace
+
 void TerrainTree::Impl::merge() {
   const auto t0 = std::chrono::steady_clock::now();
-  // Forget what was merged before.
+  // Forget what was merged before, and free its storage before this merge allocates its own:
+  // a slide (section 4.3) merges again into a moved window, and a container only cleared
+  // would keep the capacity of the largest merge so far (measured in terravol fly: the merged
+  // vertices' doubles grew to 201 MB at the second slide of examples/utah-flight.json and
+  // stayed there).
   positions.resize(merged_base());
-  merged_positions.clear();
-  merged_colors.clear();
-  polygons.clear();
-  poly_vertices.clear();
-  node_polys.clear();
-  extras.clear();
-  leaf_nodes.clear();
-  leaf_polys.clear();
+  fit(positions);
+  release(merged_colors);
+  release(polygons);
+  release(poly_vertices);
+  release(node_polys);
+  release(extras);
+  release(leaf_nodes);
+  release(leaf_polys);
   for (Node& node : nodes) node.extra = -1;
   merge_stats = {};
   if (merge_input_triangles.empty()) return;
 
-  Merger merger(*this);
-  for (std::size_t v = 0; v < merge_input_positions.size(); ++v) {
-    merger.add_vertex(merge_input_positions[v], merge_input_colors[v]);
-  }
-  const std::uint32_t base = merged_base();
-  for (std::size_t t = 0; t + 2 < merge_input_triangles.size(); t += 3) {
-    Work w;
-    w.verts = {base + merge_input_triangles[t], base + merge_input_triangles[t + 1], base + merge_input_triangles[t + 2]};
-    PlaneD unused;
-    if (!merger.plane_of(w, unused)) continue;  // zero-area triangles draw nothing
-    merger.insert(std::move(w));
-  }
-  merger.finish();
+  {
+    Merger merger(*this);
+    for (std::size_t v = 0; v < merge_input_positions.size(); ++v) {
+      merger.add_vertex(merge_input_positions[v], merge_input_colors[v]);
+    }
+    const std::uint32_t base = merged_base();
+    for (std::size_t t = 0; t + 2 < merge_input_triangles.size(); t += 3) {
+      Work w;
+      w.verts = {base + merge_input_triangles[t], base + merge_input_triangles[t + 1], base + merge_input_triangles[t + 2]};
+      PlaneD unused;
+      if (!merger.plane_of(w, unused)) continue;  // zero-area triangles draw nothing
+      merger.insert(std::move(w));
+    }
+    merger.finish();
+    merger.emit_positions();
+  }  // the merge's scratch (double vertices, polygons per node) is freed here, before fitting
+  fit(merged_colors);
+  fit(polygons);
+  fit(poly_vertices);
+  fit(node_polys);
+  fit(extras);
+  fit(leaf_nodes);
+  fit(leaf_polys);
   merge_stats.input_triangles = merge_input_triangles.size() / 3;
   merge_stats.stored_polygons = polygons.size();
-  merge_stats.merged_vertices = merged_positions.size();
+  merge_stats.merged_vertices = merged_colors.size();
   merge_stats.merge_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -286,6 +324,10 @@ MergeStats TerrainTree::merge(std::span<const glm::dvec3> vertices, std::span<co
   for (std::uint32_t i : triangles) {
     if (i >= vertices.size()) throw std::invalid_argument("TerrainTree::merge: index " + std::to_string(i) + " out of range");
   }
+  // Exactly sized copies (assign() would keep a larger earlier capacity).
+  release(impl_->merge_input_positions);
+  release(impl_->merge_input_colors);
+  release(impl_->merge_input_triangles);
   impl_->merge_input_positions.assign(vertices.begin(), vertices.end());
   impl_->merge_input_colors.assign(colors.begin(), colors.end());
   impl_->merge_input_triangles.assign(triangles.begin(), triangles.end());

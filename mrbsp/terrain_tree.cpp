@@ -191,8 +191,17 @@ TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::m
     offset += static_cast<std::uint32_t>(m.level_cells[l]) * static_cast<std::uint32_t>(m.level_cells[l]);
   }
   m.total_cells = offset;
-  m.nodes.reserve(static_cast<std::size_t>(offset) * 2);
+  // Exactly the nodes build_region makes: a cell node per cell of every level; the c0 x c0
+  // level-0 cells need c0^2 - 1 split nodes above them, and each cell with a finer level below
+  // splits its high alternative into 2 x 2 cells with 3 more.
+  const std::size_t c0 = static_cast<std::size_t>(m.level_cells[0]);
+  const std::size_t finest = static_cast<std::size_t>(m.level_cells[levels - 1]) * static_cast<std::size_t>(m.level_cells[levels - 1]);
+  const std::size_t node_count = offset + (c0 * c0 - 1) + 3 * (offset - finest);
+  m.nodes.reserve(node_count);
   m.build_region(0, 0, n, n, 0);
+  if (m.nodes.size() != node_count) {
+    throw std::logic_error("TerrainTree: built " + std::to_string(m.nodes.size()) + " nodes, expected " + std::to_string(node_count));
+  }
   m.refresh(window);
 }
 
@@ -204,6 +213,29 @@ int TerrainTree::cells() const { return impl_->n; }
 int TerrainTree::levels() const { return impl_->levels; }
 const std::vector<glm::vec3>& TerrainTree::positions() const { return impl_->positions; }
 void TerrainTree::slide(const TerrainWindow& window) { impl_->refresh(window); }
+
+namespace {
+
+template <class T>
+std::size_t held(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
+}  // namespace
+
+MemoryStats TerrainTree::memory() const {
+  const Impl& m = *impl_;
+  MemoryStats s;
+  s.samples = m.lattice_count();
+  s.nodes = held(m.nodes) + held(m.level_offset) + held(m.level_cells) + held(m.level0_error) + held(m.xs) + held(m.ys);
+  // positions holds both: the terrain's blocks up to merged_base(), merged vertices after.
+  const std::size_t terrain = std::min<std::size_t>(m.merged_base(), m.positions.capacity());
+  s.vertices = terrain * sizeof(glm::vec3);
+  s.merged = held(m.positions) - s.vertices + held(m.merge_input_positions) + held(m.merge_input_colors) +
+             held(m.merge_input_triangles) + held(m.merged_colors) + held(m.polygons) + held(m.poly_vertices) +
+             held(m.node_polys) + held(m.extras) + held(m.leaf_nodes) + held(m.leaf_polys);
+  return s;
+}
 
 namespace {
 

@@ -68,6 +68,18 @@ struct MergeStats {
   double merge_ms = 0.0;
 };
 
+// Bytes a TerrainTree holds, by part: the capacities of its containers times their element
+// sizes (what the allocator gave them, not what is in use), for benchmarks and memory checks.
+// Allocator overhead and the Impl object itself are not counted.
+struct MemoryStats {
+  std::size_t nodes = 0;     // tree nodes and per-level tables (cell ids, errors), plane offsets
+  std::size_t vertices = 0;  // positions of lattice samples and skirt bottoms (not merged ones)
+  std::size_t merged = 0;    // everything merge() keeps: inputs, merged vertices and colours,
+                             // polygons, coplanar lists, leaf BSPs
+  std::size_t samples = 0;   // lattice samples, (n+1)^2: a count, not bytes
+  std::size_t total() const { return nodes + vertices + merged; }
+};
+
 // What one traversal produced. Triangles are index triples into TerrainTree::positions(),
 // in draw order. level[t] is the LOD level of triangle t, kSkirtLevel or kMergedLevel.
 struct Frame {
@@ -138,6 +150,14 @@ class TerrainTree {
   // RGBA of merged vertex k, which is positions()[merged_base() + k].
   const std::vector<glm::u8vec4>& merged_colors() const;
   std::uint32_t merged_base() const;
+
+  // The bytes held now, by part (MemoryStats). nodes and vertices depend only on cells() and
+  // levels(): about 170 bytes per lattice sample for 3 or more levels (2.3 nodes of 56 bytes
+  // and three 12-byte positions per sample), so about 4x when the window's side doubles, and
+  // unchanged by slide(). merged is 0 before any merge() and after merging nothing; merge()
+  // and slide() free what the merge before held and size its containers to what they hold,
+  // so it follows the current merge, not the largest one so far.
+  MemoryStats memory() const;
 
   struct Impl;  // defined in mrbsp/tree_impl.h, private to mrbsp/
 

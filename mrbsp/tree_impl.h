@@ -62,11 +62,14 @@ struct TerrainTree::Impl {
   std::uint32_t total_cells = 0;
   std::vector<float> level0_error;  // per level-0 cell: the largest error of any cell inside it
 
-  // Merged polygons (merge.cpp). Kept so that slide() can merge them again.
+  // Merged polygons (merge.cpp). The inputs are kept so that slide() can merge them again.
+  // Every merge releases what the one before held and leaves each container at the size it
+  // needs (no growth slack), so memory follows the current merge, not the largest so far.
+  // The merged vertices are kept once, as floats in `positions`: their double copies, which
+  // classification needs, live only while a merge runs.
   std::vector<glm::dvec3> merge_input_positions;
   std::vector<glm::u8vec4> merge_input_colors;
   std::vector<std::uint32_t> merge_input_triangles;
-  std::vector<glm::dvec3> merged_positions;  // double copies of the merged vertices
   std::vector<glm::u8vec4> merged_colors;
   std::vector<Polygon> polygons;
   std::vector<std::uint32_t> poly_vertices;

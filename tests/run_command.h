@@ -20,11 +20,11 @@ struct CommandResult {
   double seconds = 0.0;
 };
 
-// Runs `terravol ARGS` through the shell with a 30 s limit (coreutils timeout).
-inline CommandResult run_terravol(const std::string& args) {
+// Runs `terravol ARGS` through the shell with a time limit (coreutils timeout).
+inline CommandResult run_terravol(const std::string& args, int timeout_s = 30) {
   static TempDir dir;
   const auto out = dir.path() / "stdout", err = dir.path() / "stderr";
-  const std::string cmd = "timeout 30 " + std::string(TERRAVOL_EXE) + " " + args + " >" + out.string() + " 2>" +
+  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + std::string(TERRAVOL_EXE) + " " + args + " >" + out.string() + " 2>" +
                           err.string() + " </dev/null";
   const auto t0 = std::chrono::steady_clock::now();
   const int raw = std::system(cmd.c_str());

@@ -53,6 +53,31 @@ TEST(InfoCli, SampleDemIsRegeneratedByteForByte) {
   EXPECT_EQ(again.status, 1) << "an existing file is not overwritten without --force";
 }
 
+TEST(InfoCli, SampleDemTilesMakeOneSeamlessMosaicWhoseFirstTileIsTheBundledOne) {
+  test::TempDir dir;
+  const auto r = run_terravol("sample-dem --tiles 2x2 -o " + dir.path().string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(slurp(dir.path() / "N45E006.hgt"), slurp(std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"));
+  // Neighbours share their edge samples (big-endian int16, row 0 north): N46E006's south row is
+  // N45E006's north row, N45E007's west column is N45E006's east column.
+  const std::string sw = slurp(dir.path() / "N45E006.hgt"), nw = slurp(dir.path() / "N46E006.hgt");
+  const std::string se = slurp(dir.path() / "N45E007.hgt");
+  ASSERT_EQ(nw.size(), 1201u * 1201u * 2u);
+  EXPECT_EQ(nw.substr(1200u * 1201u * 2u), sw.substr(0, 1201u * 2u));
+  for (std::size_t row = 0; row < 1201; row += 100)
+    EXPECT_EQ(se.substr(row * 1201 * 2, 2), sw.substr((row * 1201 + 1200) * 2, 2)) << row;
+  EXPECT_NE(nw, sw);
+  const auto j = info_json((dir.path() / "N45E006.hgt").string() + " " + (dir.path() / "N46E006.hgt").string() + " " +
+                           (dir.path() / "N45E007.hgt").string() + " " + (dir.path() / "N46E007.hgt").string());
+  EXPECT_EQ(j["rows"], 2401);
+  EXPECT_EQ(j["cols"], 2401);
+  EXPECT_EQ(run_terravol("sample-dem --tiles 0x3 -o " + dir.path().string()).status, 1);
+}
+
 // The table of ../shared/data/README.md: grid, bounds and elevation range of each file.
 struct Expected {
   const char* file;

@@ -1,0 +1,262 @@
+#include "bench/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "app/write_file.h"
+#include "bench/plot.h"
+
+namespace terravol::bench {
+
+namespace {
+
+using nlohmann::json;
+
+std::string num(double v, const char* format = "%.3g") {
+  if (std::isinf(v)) return "inf";
+  if (std::isnan(v)) return "n/a";
+  char b[48];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+// "median (p10-p90)" of a Summary.
+std::string spread(const json& s, const char* format = "%.3g") {
+  return num(s["median"].get<double>(), format) + " (" + num(s["p10"].get<double>(), format) + "–" +
+         num(s["p90"].get<double>(), format) + ")";
+}
+
+double med(const json& s) { return s["median"].get<double>(); }
+
+const json* find_config(const json& terrain, const std::string& metric, double t) {
+  for (const json& k : terrain["mrbsp"])
+    if (k["metric"] == metric && k["threshold"].get<double>() == t) return &k;
+  return nullptr;
+}
+
+std::string pct(double share) { return num(100.0 * share, "%.3g") + "%"; }
+
+void terrain_section(std::ostringstream& md, const json& results, const std::filesystem::path& dir) {
+  if (!results.contains("terrain")) return;
+  md << "## 1. Terrain flythrough\n\n"
+     << "Per view: the full-resolution window drawn by plain VTK (ordinary mapper, depth test, every "
+        "triangle, geometry uploaded once) and by the MRBSP at four thresholds of each LOD metric "
+        "(screen-space error in pixels; projected box area in 250 t square pixels, so that t = 2 is its "
+        "default of 500). Frame time = traversal + upload of the triangle list + draw. Image quality "
+        "against Terravol's own full-resolution image of the same view. Figures are medians over the "
+        "views (10th–90th percentile in brackets) of per-view medians over the repetitions.\n\n";
+  std::vector<Series> tri, err;
+  for (const json& t : results["terrain"]) {
+    const std::string name = t["terrain"];
+    md << "### " << name << " (" << t["window_cells"].get<int>() << " cells, " << t["levels"].get<int>() << " levels, "
+       << t["views"].get<int>() << " views)\n\n";
+    md << "| configuration | frame ms | traversal ms | draw ms | triangles | PSNR dB | SSIM | pixels > 8/255 | plain VTK / this |\n"
+       << "|---|---|---|---|---|---|---|---|---|\n";
+    const json& p = t["plain_vtk"];
+    md << "| plain VTK, full resolution | " << spread(p["frame_ms"]) << " | – | – | " << num(p["triangles"].get<double>(), "%.0f")
+       << " | " << num(med(p["psnr_against_reference"]), "%.1f") << " (against Terravol's) | – | – | 1 |\n"
+     << "| Terravol, full resolution (the reference; triangles in the view frustum) | – | – | – | "
+     << num(med(p["full_res_in_view"]), "%.0f") << " | – | – | – | – |\n";
+    for (const char* metric : {"error", "area"}) {
+      Series st{name + " " + metric, {}, {}, false}, se{name + " " + metric, {}, {}, false};
+      for (double th : {0.5, 1.0, 2.0, 4.0}) {
+        const json* k = find_config(t, metric, th);
+        if (!k) continue;
+        md << "| MRBSP " << metric << " " << num(th) << " | " << spread((*k)["frame_ms"]) << " | "
+           << spread((*k)["traversal_ms"]) << " | " << spread((*k)["draw_ms"]) << " | "
+           << num(med((*k)["triangles"]), "%.0f") << " | " << spread((*k)["psnr_db"], "%.1f") << " | "
+           << num(med((*k)["ssim"]), "%.4f") << " | " << pct(med((*k)["share_over_8"])) << " | "
+           << spread((*k)["plain_over_mrbsp"]) << " |\n";
+        st.x.push_back(th);
+        st.y.push_back(med((*k)["triangles"]));
+        se.x.push_back(th);
+        se.y.push_back(med((*k)["psnr_db"]));
+      }
+      if (!st.x.empty()) tri.push_back(st);
+      if (!se.x.empty()) err.push_back(se);
+    }
+    md << "\n";
+    // Frame time along the path.
+    ChartSpec along;
+    along.title = "Frame time along the " + name + " flythrough";
+    along.x_label = "view";
+    along.y_label = "frame time (ms)";
+    along.log_y = true;
+    Series plain{"plain VTK, full resolution", {}, p["per_view_ms"].get<std::vector<double>>(), false};
+    for (std::size_t i = 0; i < plain.y.size(); ++i) plain.x.push_back(static_cast<double>(i));
+    along.series.push_back(plain);
+    for (double th : {0.5, 1.0, 4.0}) {
+      const json* k = find_config(t, "error", th);
+      if (!k) continue;
+      Series s{"MRBSP " + num(th) + " px", plain.x, (*k)["per_view_ms"].get<std::vector<double>>(), false};
+      along.series.push_back(s);
+    }
+    const std::string file = "plot-frame-time-" + name + ".png";
+    write_chart_png(dir / file, along);
+    md << "![Frame time along the " << name << " path](" << file << ")\n\n";
+  }
+  if (tri.empty()) return;
+  ChartSpec c1{"Triangles drawn against the threshold", "threshold t", "triangles per frame (median)", tri, true, true};
+  write_chart_png(dir / "plot-triangles-threshold.png", c1);
+  ChartSpec c2{"Image quality against the threshold", "threshold t", "PSNR against full resolution (dB, median)", err, true, false};
+  write_chart_png(dir / "plot-error-threshold.png", c2);
+  md << "![Triangles against threshold](plot-triangles-threshold.png)\n\n"
+     << "![PSNR against threshold](plot-error-threshold.png)\n\n";
+}
+
+void translucency_section(std::ostringstream& md, const json& results) {
+  if (!results.contains("translucency")) return;
+  md << "## 2. Translucency, and 6. the pipeline users would otherwise build\n\n"
+     << "Three overlapping RF volumes (two translucent isosurfaces each, and a slice), viewed from an "
+        "orbit around them. The first four rows draw the same traversal (the same triangles): in the "
+        "tree's order (bsp), by VTK's depth peeling with ParaView's 4 peels, with no limit on peels "
+        "(exact: the reference), and by VTK 9.1's default (weighted blended OIT). The plain rows are "
+        "what a ParaView or plain-VTK user would draw: the full-resolution lattice and undecimated "
+        "isosurfaces and slice, geometry uploaded once, depth peeling with 4 peels or no limit; their "
+        "error is against their own exact image. Frame times are medians over the views.\n\n";
+  for (const json& t : results["translucency"]) {
+    const json& m = t["merge"];
+    md << "### " << t["terrain"].get<std::string>() << " (" << t["views"].get<int>() << " views, orbit "
+       << num(t["orbit_km"].get<double>()) << " km)\n\n"
+       << "Merged: " << m["input_triangles"].get<std::size_t>() << " triangles after decimation ("
+       << m["undecimated_triangles"].get<std::size_t>() << " before) became " << m["tree_polygons"].get<std::size_t>()
+       << " pieces in the tree; geometry " << num(m["geometry_ms"].get<double>(), "%.0f") << " ms, merge "
+       << num(m["merge_ms"].get<double>(), "%.0f") << " ms, " << num(m["merged_bytes"].get<double>() / 1048576.0, "%.0f")
+       << " MiB. Triangles per frame: " << num(med(t["triangles"]), "%.0f") << " (of them merged "
+       << num(med(t["merged_triangles"]), "%.0f") << "); plain pipeline " << num(med(t["plain_triangles"]), "%.0f")
+       << ".\n\n"
+       << "| drawing | frame ms | this / bsp | pixels > 3/255 from exact | PSNR dB |\n|---|---|---|---|---|\n";
+    for (const char* name : {"bsp", "peel_exact", "peel4", "vtk_default", "plain_peel4", "plain_peel_exact"}) {
+      md << "| " << name << " | " << spread(t["frame_ms"][name]) << " | "
+         << (t["ratio_over_bsp"].contains(name) ? spread(t["ratio_over_bsp"][name]) : std::string("1")) << " | "
+         << (t["share_over_3"].contains(name) ? pct(med(t["share_over_3"][name])) : std::string("0 (reference)")) << " | "
+         << (t["psnr_db"].contains(name) ? num(med(t["psnr_db"][name]), "%.1f") : std::string("–")) << " |\n";
+    }
+    const json& r = t["responsiveness"];
+    md << "\n**Responsiveness** (5): threshold change to finished frame " << spread(r["threshold_change_ms"], "%.0f")
+       << " ms; slice move to finished frame " << spread(r["slice_move_ms"], "%.0f") << " ms (of which merge "
+       << spread(r["slice_move_merge_ms"], "%.0f") << " ms).\n\n";
+  }
+}
+
+void scaling_section(std::ostringstream& md, const json& results, const std::filesystem::path& dir) {
+  if (!results.contains("scaling")) return;
+  md << "## 3. Scaling\n\n"
+     << "One view (2500 m above the window's centre, pitch −20°, heading 30°) of each terrain in its "
+        "largest power-of-two window (at most 4096 cells), MRBSP at 1 px against plain VTK at full "
+        "resolution.\n\n"
+     << "| terrain | tiles | samples | tree MiB | MRBSP frame ms | MRBSP triangles | plain VTK frame ms | plain triangles |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  // The generated terrains as curves; real terrains as single points beside them.
+  std::vector<Series> series;
+  auto add = [&](const std::string& name, bool points, double x, double y) {
+    for (Series& s : series)
+      if (s.name == name) {
+        s.x.push_back(x);
+        s.y.push_back(y);
+        return;
+      }
+    series.push_back({name, {x}, {y}, points});
+  };
+  for (const json& s : results["scaling"]) {
+    const double samples = s["samples"].get<double>();
+    const std::string name = s["terrain"];
+    md << "| " << name << " | " << s["tiles"].get<int>() << " | " << num(samples, "%.0f")
+       << " | " << num(s["tree_bytes"].get<double>() / 1048576.0, "%.0f") << " | " << spread(s["mrbsp_frame_ms"]) << " | "
+       << s["mrbsp_triangles"].get<std::size_t>() << " | "
+       << (s.contains("plain_frame_ms") ? spread(s["plain_frame_ms"]) : std::string("not drawn")) << " | "
+       << (s.contains("plain_triangles") ? std::to_string(s["plain_triangles"].get<std::size_t>()) : std::string("–"))
+       << " |\n";
+    const bool generated = name.rfind("generated", 0) == 0;
+    const std::string which = generated ? " (generated tiles)" : " (" + name + ")";
+    add("MRBSP 1 px" + which, !generated, samples, med(s["mrbsp_frame_ms"]));
+    if (s.contains("plain_frame_ms")) add("plain VTK, full resolution" + which, !generated, samples, med(s["plain_frame_ms"]));
+  }
+  ChartSpec c{"Frame time against terrain size (one view)", "DEM samples in the window", "frame time (ms)", series, true, true};
+  write_chart_png(dir / "plot-scaling.png", c);
+  md << "\n![Scaling](plot-scaling.png)\n\n";
+}
+
+void build_section(std::ostringstream& md, const json& results) {
+  if (!results.contains("build")) return;
+  md << "## 4. Build and slide\n\n"
+     << "The tree of a 1024-cell window alone (no rendering, the lattice already read): build, and a "
+        "slide by one coarsest cell (Wiley et al. 1997, section 4.3).\n\n"
+     << "| terrain | samples | build ms | slide ms | build / slide | samples per second | bytes per sample (nodes + vertices) |\n"
+     << "|---|---|---|---|---|---|---|\n";
+  for (const json& b : results["build"]) {
+    md << "| " << b["terrain"].get<std::string>() << " | " << b["samples"].get<std::size_t>() << " | "
+       << spread(b["build_ms"], "%.1f") << " | " << spread(b["slide_ms"], "%.1f") << " | "
+       << num(b["build_over_slide"].get<double>(), "%.2f") << " | "
+       << num(b["build_samples_per_s"].get<double>() / 1e6, "%.2f") << " M | "
+       << num(b["bytes_per_sample"]["total"].get<double>(), "%.0f") << " ("
+       << num(b["bytes_per_sample"]["nodes"].get<double>(), "%.0f") << " + "
+       << num(b["bytes_per_sample"]["vertices"].get<double>(), "%.0f") << ") |\n";
+  }
+  md << "\n";
+}
+
+}  // namespace
+
+std::string headline(const json& results) {
+  std::ostringstream h;
+  if (results.contains("terrain"))
+    for (const json& t : results["terrain"])
+      h << "full-res VTK / MRBSP at 1 px, " << t["terrain"].get<std::string>() << ": "
+        << num(t["headline_ratio_1px"].get<double>(), "%.1f") << "x\n";
+  if (results.contains("translucency"))
+    for (const json& t : results["translucency"]) {
+      const std::string n = t["terrain"];
+      h << "translucency " << n << ": exact peeling / bsp " << num(med(t["ratio_over_bsp"]["peel_exact"]), "%.2f")
+        << "x, 4 peels / bsp " << num(med(t["ratio_over_bsp"]["peel4"]), "%.2f") << "x, VTK default / bsp "
+        << num(med(t["ratio_over_bsp"]["vtk_default"]), "%.2f") << "x; pixels > 3/255 from exact: bsp "
+        << pct(med(t["share_over_3"]["bsp"])) << ", 4 peels " << pct(med(t["share_over_3"]["peel4"]))
+        << ", VTK default " << pct(med(t["share_over_3"]["vtk_default"])) << "\n";
+      h << "depth-peeled full-res VTK / Terravol, " << n << ": 4 peels "
+        << num(med(t["ratio_over_bsp"]["plain_peel4"]), "%.1f") << "x, exact "
+        << num(med(t["ratio_over_bsp"]["plain_peel_exact"]), "%.1f") << "x\n";
+    }
+  if (results.contains("scaling") && results["scaling"].size() >= 2) {
+    const json& a = results["scaling"].front();
+    const json& b = results["scaling"].back();
+    h << "scaling " << a["terrain"].get<std::string>() << " -> " << b["terrain"].get<std::string>() << " ("
+      << num(b["samples"].get<double>() / a["samples"].get<double>(), "%.1f") << "x the samples): MRBSP frame time "
+      << num(med(b["mrbsp_frame_ms"]) / med(a["mrbsp_frame_ms"]), "%.2f") << "x";
+    if (a.contains("plain_frame_ms") && b.contains("plain_frame_ms"))
+      h << ", plain VTK " << num(med(b["plain_frame_ms"]) / med(a["plain_frame_ms"]), "%.1f") << "x";
+    h << "\n";
+  }
+  if (results.contains("build"))
+    for (const json& b : results["build"])
+      h << "slide / build, " << b["terrain"].get<std::string>() << ": 1/"
+        << num(b["build_over_slide"].get<double>(), "%.1f") << "\n";
+  return h.str();
+}
+
+void write_report(const json& results, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  std::ostringstream md;
+  const json& m = results["machine"];
+  md << "# Benchmarks\n\n"
+     << (results["quick"].get<bool>() ? "A quick run (`bench/run --quick`): fewer views and repetitions.\n\n" : "")
+     << "Run on " << results["date"].get<std::string>() << ", " << m["cpu"].get<std::string>() << ", "
+     << m["cores"].get<int>() << " cores, " << num(m["memory_gib"].get<double>(), "%.0f") << " GiB, "
+     << m["renderer"].get<std::string>() << ", " << results["width"].get<int>() << "x" << results["height"].get<int>()
+     << " offscreen; " << results["repeats"].get<int>() << " timed repetitions per frame after a warm-up. "
+     << "Every comparison was measured side by side in this one run. Total time "
+     << num(results["seconds"].get<double>() / 60.0, "%.1f") << " min. Made by `" << results["command"].get<std::string>()
+     << "`; the figures are in `results.json`.\n\n"
+     << "## Headline\n\n```\n" << headline(results) << "```\n\n";
+  terrain_section(md, results, dir);
+  translucency_section(md, results);
+  scaling_section(md, results, dir);
+  build_section(md, results);
+  const std::string text = md.str();
+  app::write_file_atomically(dir / "report.md", std::vector<std::uint8_t>(text.begin(), text.end()), true);
+  const std::string j = results.dump(1);
+  app::write_file_atomically(dir / "results.json", std::vector<std::uint8_t>(j.begin(), j.end()), true);
+}
+
+}  // namespace terravol::bench

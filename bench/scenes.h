@@ -1,0 +1,52 @@
+// The terrains, volumes and camera paths the benchmarks draw (docs/benchmarks.md).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/camera.h"
+#include "app/scene_file.h"
+#include "app/terrain_scene.h"
+#include "volume/propagation.h"
+
+namespace terravol::bench {
+
+// A terrain of the shared data (or made by `terravol sample-dem --tiles`).
+struct Terrain {
+  std::string name;                          // "n44w072", "utah", ...
+  std::vector<std::filesystem::path> dems;
+  int tiles = 1;                             // DEM tiles in it
+};
+
+// One view of a path: a pose with its altitude above the ground.
+struct View {
+  app::CameraPose pose;  // pose.alt: metres above the ground under the camera
+  bool overview = false;
+};
+
+// A flythrough of `count` views over the central half of `bounds` (so that the window never
+// slides): low oblique views (pitch -5 to -20 degrees, 600 to 2500 m above the ground) turning
+// through every heading, and every sixth view a high overview (8000 m, pitch -45).
+// Deterministic. Precondition: count >= 1.
+std::vector<View> flythrough(const app::WindowBounds& bounds, int count);
+
+// An orbit of `count` views around (lat, lon) at `range_km`, `agl` metres above the ground,
+// looking at the centre with pitch `pitch_deg`, starting from the south-west.
+std::vector<View> orbit(double lat, double lon, double range_km, double agl, double pitch_deg, int count);
+
+// The three-volume scene of scripts/exactness.sh over a terrain: an RF path-loss volume per
+// transmitter
+// (three expected; 12 km radius, 0-2000 m, written as `<cache>/<name>-rfK.vdb` by the built-in model unless
+// already there), two translucent isosurfaces each and a slice 400 m above the ground on the
+// first. `progress` is told when a volume is computed. Throws what compute_rf and write_vdb
+// throw.
+struct VolumeScene {
+  app::SceneSpec spec;
+  double lat = 0, lon = 0;  // the centre of the transmitters
+};
+VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters,
+                               const std::filesystem::path& cache, const std::function<void(const std::string&)>& progress);
+
+}  // namespace terravol::bench

@@ -1,0 +1,428 @@
+#include "bench/suites.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "app/png_output.h"
+#include "app/scene_renderer.h"
+#include "app/volume_layer.h"
+#include "bench/image_metrics.h"
+#include "bench/plain_vtk.h"
+#include "bench/stats.h"
+#include "io/mosaic.h"
+
+namespace terravol::bench {
+
+namespace {
+
+using nlohmann::json;
+
+void say(const BenchConfig& c, const std::string& line) {
+  if (c.log) c.log(line);
+}
+
+app::RenderSettings plain_settings(const BenchConfig& c) {
+  app::RenderSettings s;
+  s.width = c.width;
+  s.height = c.height;
+  s.gradient = false;  // one background colour in every pipeline, so images compare
+  s.haze_distance = 0.0;
+  return s;
+}
+
+// The scene of a terrain with its window centred on (lat, lon) (the mosaic's centre when both
+// are NaN) at most `max_window` cells wide.
+app::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double lon = std::nan("")) {
+  app::SceneSpec spec;
+  spec.dems = t.dems;
+  if (!std::isnan(lat)) {
+    app::SceneCamera cam;
+    cam.pose.lat = lat;
+    cam.pose.lon = lon;
+    cam.pose.alt = 1000;
+    cam.agl = true;
+    spec.camera = cam;
+  }
+  return spec;
+}
+
+// Frame time of the MRBSP: traversal, the upload of its triangle list, and the draw.
+double frame_ms(const app::FrameStats& s) { return s.traversal_ms + s.upload_ms + s.draw_ms; }
+
+mrbsp::TraversalOptions lod(mrbsp::LodMetric metric, double t) {
+  mrbsp::TraversalOptions o;
+  o.metric = metric;
+  o.threshold_px = static_cast<float>(metric == mrbsp::LodMetric::kError ? t : 250.0 * t);
+  return o;
+}
+
+// The full-resolution lattice of the scene's window drawn by plain VTK, with a translucent
+// overlay (empty: none).
+std::unique_ptr<PlainVtkScene> plain_scene(const app::SceneRenderer& scene, const volume::Mesh& overlay,
+                                           Translucency translucency, const BenchConfig& c) {
+  const int n = scene.terrain().cells();
+  const auto& positions = scene.terrain().tree().positions();
+  const std::size_t lattice = static_cast<std::size_t>(n + 1) * static_cast<std::size_t>(n + 1);
+  const std::vector<std::uint32_t> triangles = lattice_triangles(n);
+  PlainVtkOptions o;
+  o.width = c.width;
+  o.height = c.height;
+  o.translucency = translucency;
+  o.background = plain_settings(c).background;
+  return std::make_unique<PlainVtkScene>(std::span(positions.data(), lattice), scene.lattice_shading().rgba,
+                                         triangles, overlay.vertices, overlay.colors, overlay.triangles, o);
+}
+
+double far_plane(const app::SceneRenderer& scene) { return scene.terrain().far_plane(scene.camera().eye); }
+
+}  // namespace
+
+json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
+  say(c, "terrain " + terrain.name + ": building the 1024-cell window");
+  app::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), 1024, 0, {}, false);
+  auto plain = plain_scene(scene, {}, Translucency::kPeel4, c);
+  const std::vector<View> views = flythrough(scene.terrain().bounds(), c.views);
+
+  struct Config {
+    mrbsp::LodMetric metric;
+    double t;
+    std::vector<double> traversal, upload, draw, frame, triangles, psnr, ssim, share8, ratio;
+  };
+  std::vector<Config> configs;
+  for (auto metric : {mrbsp::LodMetric::kError, mrbsp::LodMetric::kArea})
+    for (double t : {0.5, 1.0, 2.0, 4.0}) configs.push_back({metric, t, {}, {}, {}, {}, {}, {}, {}, {}, {}});
+  std::vector<double> plain_ms, full_triangles, plain_psnr;
+  mrbsp::TraversalOptions full;
+  full.full_res = true;
+
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const app::CameraPose& pose = views[v].pose;
+    // The reference image: every triangle of the window at the finest level, in tree order.
+    const app::FrameStats ref = scene.render(pose, true, 45.0, full);
+    const std::vector<std::uint8_t> reference = scene.rgb();
+    full_triangles.push_back(static_cast<double>(ref.triangles));
+    plain->set_camera(scene.camera(), far_plane(scene));
+    if (v == 0) plain->render();  // warm-up: the first draw uploads the geometry
+    std::vector<double> p;
+    for (int r = 0; r < c.repeats; ++r) p.push_back(plain->render());
+    plain_ms.push_back(median(p));
+    plain_psnr.push_back(psnr(plain->rgb(), reference, c.width, c.height));
+
+    for (Config& k : configs) {
+      const mrbsp::TraversalOptions o = lod(k.metric, k.t);
+      if (v == 0) scene.render(pose, true, 45.0, o);  // warm-up
+      std::vector<double> tr, up, dr, fr;
+      app::FrameStats s;
+      for (int r = 0; r < c.repeats; ++r) {
+        s = scene.render(pose, true, 45.0, o);
+        tr.push_back(s.traversal_ms);
+        up.push_back(s.upload_ms);
+        dr.push_back(s.draw_ms);
+        fr.push_back(frame_ms(s));
+      }
+      const std::vector<std::uint8_t> image = scene.rgb();
+      k.traversal.push_back(median(tr));
+      k.upload.push_back(median(up));
+      k.draw.push_back(median(dr));
+      k.frame.push_back(median(fr));
+      k.triangles.push_back(static_cast<double>(s.triangles));
+      k.psnr.push_back(std::min(99.0, psnr(image, reference, c.width, c.height)));
+      k.ssim.push_back(ssim(image, reference, c.width, c.height));
+      k.share8.push_back(share_differing(image, reference, c.width, c.height, 8));
+      k.ratio.push_back(plain_ms.back() / k.frame.back());
+    }
+    char b[160];
+    std::snprintf(b, sizeof b, "terrain %s: view %zu/%zu  plain VTK %.0f ms, MRBSP 1 px %.1f ms", terrain.name.c_str(),
+                  v + 1, views.size(), plain_ms.back(), configs[1].frame.back());
+    say(c, b);
+  }
+
+  json out;
+  out["terrain"] = terrain.name;
+  out["window_cells"] = scene.terrain().cells();
+  out["levels"] = scene.terrain().tree().levels();
+  out["views"] = views.size();
+  out["repeats"] = c.repeats;
+  out["plain_vtk"] = {{"frame_ms", to_json(summarize(plain_ms))},
+                      {"triangles", plain->triangles()},
+                      {"full_res_in_view", to_json(summarize(full_triangles))},
+                      {"psnr_against_reference", to_json(summarize(plain_psnr))},
+                      {"per_view_ms", plain_ms}};
+  json list = json::array();
+  for (const Config& k : configs) {
+    json j;
+    j["metric"] = k.metric == mrbsp::LodMetric::kError ? "error" : "area";
+    j["threshold"] = k.t;
+    j["threshold_px_or_px2"] = lod(k.metric, k.t).threshold_px;
+    j["traversal_ms"] = to_json(summarize(k.traversal));
+    j["upload_ms"] = to_json(summarize(k.upload));
+    j["draw_ms"] = to_json(summarize(k.draw));
+    j["frame_ms"] = to_json(summarize(k.frame));
+    j["triangles"] = to_json(summarize(k.triangles));
+    j["psnr_db"] = to_json(summarize(k.psnr));
+    j["ssim"] = to_json(summarize(k.ssim));
+    j["share_over_8"] = to_json(summarize(k.share8));
+    j["plain_over_mrbsp"] = to_json(summarize(k.ratio));
+    j["per_view_ms"] = k.frame;
+    j["per_view_triangles"] = k.triangles;
+    list.push_back(j);
+  }
+  out["mrbsp"] = list;
+  out["headline_ratio_1px"] = summarize(configs[1].ratio).median;
+  return out;
+}
+
+json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters) {
+  const VolumeScene vs = three_volume_scene(terrain, transmitters, c.cache, c.log);
+  app::SceneSpec spec = vs.spec;
+  spec.camera = terrain_spec(terrain, vs.lat, vs.lon).camera;  // the window centred on the volumes
+  say(c, "translucency " + terrain.name + ": reading the volumes and merging them into the tree");
+  app::SceneRenderer scene(spec, plain_settings(c), 1024, 0, {}, false);
+  const app::MergeFigures merged = scene.merge_figures();
+  const mrbsp::MemoryStats memory = scene.terrain().tree().memory();
+
+  // The same traversal in VTK's orders.
+  auto order = [&](app::DrawOrder o, int peels) {
+    app::RenderSettings s = plain_settings(c);
+    s.order = o;
+    s.peels = peels;
+    return scene.make_renderer(s);
+  };
+  auto peel_exact = order(app::DrawOrder::kPeel, 0);
+  auto peel4 = order(app::DrawOrder::kPeel, 4);
+  auto oit = order(app::DrawOrder::kVtk, 0);
+
+  // What a ParaView user would draw: the full lattice and undecimated geometry.
+  say(c, "translucency " + terrain.name + ": the plain VTK pipeline (undecimated geometry)");
+  const io::Mosaic mosaic = io::Mosaic::open(spec.dems);
+  const auto t0 = Clock::now();
+  const app::VolumeLayer raw(spec.volumes, mosaic, scene.frame(), 0);
+  const volume::Mesh raw_mesh = raw.visible_mesh();
+  const double raw_geometry_ms = ms_since(t0);
+  auto plain4 = plain_scene(scene, raw_mesh, Translucency::kPeel4, c);
+  auto plain_exact = plain_scene(scene, raw_mesh, Translucency::kPeelExact, c);
+
+  // Views around the volumes, within the central half of the window (no slides).
+  const app::WindowBounds b = scene.terrain().bounds();
+  const double half_km = 0.5 * std::min((b.north - b.south) * 111.32,
+                                        (b.east - b.west) * 111.32 * std::cos(vs.lat * 3.14159265358979 / 180.0));
+  const double range_km = std::min(8.0, 0.4 * half_km);
+  const std::vector<View> views = orbit(vs.lat, vs.lon, range_km, 2500.0, -22.0, c.volume_views);
+  const mrbsp::TraversalOptions lod_default;
+
+  std::map<std::string, std::vector<double>> ms, err3, psnr_db, ratio;
+  std::vector<double> triangles, merged_triangles, plain_triangles;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const app::CameraPose& pose = views[v].pose;
+    if (v == 0) scene.render(pose, true, 45.0, lod_default);  // warm-up
+    std::vector<double> t_bsp;
+    app::FrameStats s;
+    for (int r = 0; r < c.repeats; ++r) {
+      s = scene.render(pose, true, 45.0, lod_default);
+      t_bsp.push_back(frame_ms(s));
+    }
+    if (s.slides > 0) throw std::runtime_error("translucency " + terrain.name + ": the window slid; views must stay inside");
+    triangles.push_back(static_cast<double>(s.triangles));
+    merged_triangles.push_back(static_cast<double>(s.merged_triangles));
+    const std::vector<std::uint8_t> bsp = scene.rgb();
+    ms["bsp"].push_back(median(t_bsp));
+    const double far = far_plane(scene);
+
+    std::map<std::string, std::vector<std::uint8_t>> images;
+    auto time_order = [&](const std::string& name, app::TerrainRenderer& r) {
+      r.set_camera(scene.camera(), far);
+      if (v == 0) {
+        r.set_frame(scene.last_frame());
+        r.render();
+      }
+      std::vector<double> t;
+      for (int k = 0; k < c.repeats; ++k) {
+        const auto u0 = Clock::now();
+        r.set_frame(scene.last_frame());  // what a frame costs in this order: the upload and the draw
+        const double upload = ms_since(u0);
+        t.push_back(upload + r.render());
+      }
+      ms[name].push_back(median(t) + s.traversal_ms);  // the traversal is shared
+      images[name] = app::window_rgb(r.window());
+    };
+    time_order("peel_exact", *peel_exact);
+    time_order("peel4", *peel4);
+    time_order("vtk_default", *oit);
+    auto time_plain = [&](const std::string& name, PlainVtkScene& p) {
+      p.set_camera(scene.camera(), far);
+      if (v == 0) p.render();
+      std::vector<double> t;
+      for (int k = 0; k < c.repeats; ++k) t.push_back(p.render());
+      ms[name].push_back(median(t));
+      images[name] = p.rgb();
+    };
+    time_plain("plain_peel4", *plain4);
+    time_plain("plain_peel_exact", *plain_exact);
+    plain_triangles.push_back(static_cast<double>(plain4->triangles()));
+
+    const auto& exact = images["peel_exact"];
+    for (const auto& [name, image] : std::vector<std::pair<std::string, const std::vector<std::uint8_t>*>>{
+             {"bsp", &bsp}, {"peel4", &images["peel4"]}, {"vtk_default", &images["vtk_default"]}}) {
+      err3[name].push_back(share_differing(*image, exact, c.width, c.height, 3));
+      psnr_db[name].push_back(std::min(99.0, psnr(*image, exact, c.width, c.height)));
+    }
+    // The plain pipeline against its own exact image (same geometry).
+    err3["plain_peel4"].push_back(
+        share_differing(images["plain_peel4"], images["plain_peel_exact"], c.width, c.height, 3));
+    psnr_db["plain_peel4"].push_back(std::min(99.0, psnr(images["plain_peel4"], images["plain_peel_exact"], c.width, c.height)));
+    for (const char* name : {"peel_exact", "peel4", "vtk_default", "plain_peel4", "plain_peel_exact"})
+      ratio[name].push_back(ms[name].back() / ms["bsp"].back());
+    char b2[200];
+    std::snprintf(b2, sizeof b2, "translucency %s: view %zu/%zu  bsp %.0f ms, peel %.0f ms, plain peel4 %.0f ms",
+                  terrain.name.c_str(), v + 1, views.size(), ms["bsp"].back(), ms["peel_exact"].back(),
+                  ms["plain_peel4"].back());
+    say(c, b2);
+  }
+
+  json out;
+  out["terrain"] = terrain.name;
+  out["views"] = views.size();
+  out["orbit_km"] = range_km;
+  out["merge"] = json{{"input_triangles", merged.input_triangles},
+                  {"tree_polygons", merged.tree_triangles},
+                  {"geometry_ms", merged.geometry_ms},
+                  {"merge_ms", merged.merge_ms},
+                  {"merged_bytes", memory.merged},
+                  {"undecimated_triangles", raw_mesh.triangle_count()},
+                  {"undecimated_geometry_ms", raw_geometry_ms}};
+  out["triangles"] = to_json(summarize(triangles));
+  out["merged_triangles"] = to_json(summarize(merged_triangles));
+  out["plain_triangles"] = to_json(summarize(plain_triangles));
+  for (const auto& [name, v] : ms) out["frame_ms"][name] = to_json(summarize(v));
+  for (const auto& [name, v] : ratio) out["ratio_over_bsp"][name] = to_json(summarize(v));
+  for (const auto& [name, v] : err3) out["share_over_3"][name] = to_json(summarize(v));
+  for (const auto& [name, v] : psnr_db) out["psnr_db"][name] = to_json(summarize(v));
+
+  // 5. Responsiveness: from the change to the next finished frame, as the viewer sees it.
+  say(c, "translucency " + terrain.name + ": responsiveness");
+  const app::CameraPose pose = views.front().pose;
+  std::vector<double> threshold_ms, slice_ms, slice_merge_ms;
+  for (int r = 0; r < std::max(3, c.repeats); ++r) {
+    const auto u0 = Clock::now();
+    scene.render(pose, true, 45.0, lod(mrbsp::LodMetric::kError, r % 2 ? 2.0 : 1.0));
+    threshold_ms.push_back(ms_since(u0));
+  }
+  for (int r = 0; r < std::max(2, c.repeats - 1); ++r) {
+    volume::SliceSpec slice = spec.volumes[0].slices.at(0);
+    slice.value += r % 2 ? 0.0 : 50.0;
+    const auto u0 = Clock::now();
+    scene.volumes().set_slice(0, 0, slice);
+    slice_merge_ms.push_back(scene.remerge().merge_ms);
+    scene.render(pose, true, 45.0, lod_default);
+    slice_ms.push_back(ms_since(u0));
+  }
+  out["responsiveness"] = {{"threshold_change_ms", to_json(summarize(threshold_ms))},
+                           {"slice_move_ms", to_json(summarize(slice_ms))},
+                           {"slice_move_merge_ms", to_json(summarize(slice_merge_ms))}};
+  return out;
+}
+
+json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
+  json list = json::array();
+  for (std::size_t k = 0; k < terrains.size(); ++k) {
+    const Terrain& t = terrains[k];
+    say(c, "scaling " + t.name + ": building its largest window");
+    const auto t0 = Clock::now();
+    app::SceneRenderer scene(terrain_spec(t), plain_settings(c), 4096, 0, {}, false);
+    const double build_ms = ms_since(t0);
+    const app::WindowBounds b = scene.terrain().bounds();
+    View view;
+    view.pose.lat = 0.5 * (b.south + b.north);
+    view.pose.lon = 0.5 * (b.west + b.east);
+    view.pose.alt = 2500.0;
+    view.pose.heading_deg = 30.0;
+    view.pose.pitch_deg = -20.0;
+    const mrbsp::TraversalOptions one = lod(mrbsp::LodMetric::kError, 1.0);
+    scene.render(view.pose, true, 45.0, one);  // warm-up
+    std::vector<double> fr, tr;
+    app::FrameStats s;
+    for (int r = 0; r < std::max(3, c.repeats); ++r) {
+      s = scene.render(view.pose, true, 45.0, one);
+      fr.push_back(frame_ms(s));
+      tr.push_back(s.traversal_ms);
+    }
+    const std::size_t n = static_cast<std::size_t>(scene.terrain().cells());
+    json j;
+    j["terrain"] = t.name;
+    j["tiles"] = t.tiles;
+    j["window_cells"] = n;
+    j["samples"] = (n + 1) * (n + 1);
+    j["scene_build_ms"] = build_ms;
+    j["tree_bytes"] = scene.terrain().tree().memory().total();
+    j["mrbsp_frame_ms"] = to_json(summarize(fr));
+    j["mrbsp_traversal_ms"] = to_json(summarize(tr));
+    j["mrbsp_triangles"] = s.triangles;
+    j["mrbsp_nodes_visited"] = s.nodes_visited;
+    const bool largest = k + 1 == terrains.size();
+    if (c.plain_largest || !largest) {
+      say(c, "scaling " + t.name + ": plain VTK at full resolution");
+      auto plain = plain_scene(scene, {}, Translucency::kPeel4, c);
+      plain->set_camera(scene.camera(), far_plane(scene));
+      plain->render();  // warm-up (uploads the geometry)
+      std::vector<double> p;
+      for (int r = 0; r < std::max(2, c.repeats - 1); ++r) p.push_back(plain->render());
+      j["plain_frame_ms"] = to_json(summarize(p));
+      j["plain_triangles"] = plain->triangles();
+    }
+    char b2[200];
+    std::snprintf(b2, sizeof b2, "scaling %s: %zu samples, MRBSP %.1f ms, %zu triangles", t.name.c_str(),
+                  (n + 1) * (n + 1), summarize(fr).median, s.triangles);
+    say(c, b2);
+    list.push_back(j);
+  }
+  return list;
+}
+
+json build_suite(const BenchConfig& c, const Terrain& terrain) {
+  say(c, "build " + terrain.name + ": build and slide of a 1024-cell window");
+  const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
+  const app::WindowChoice w0 = app::choose_window(mosaic.rows(), mosaic.cols(), (mosaic.rows() - 1) / 2.0,
+                                                  (mosaic.cols() - 1) / 2.0, 1024);
+  const int levels = app::default_levels(w0.cells);
+  app::WindowChoice w1 = w0;
+  w1.col0 += 1 << (levels - 1);  // one coarsest cell east
+  if (w1.col0 + w1.cells > mosaic.cols() - 1) w1.col0 = w0.col0 - (1 << (levels - 1));
+  const io::SceneFrame frame = app::centre_frame(mosaic, w0);
+  const app::SceneWindow a = app::read_scene_window(mosaic, w0, frame);
+  const app::SceneWindow b = app::read_scene_window(mosaic, w1, frame);
+  auto view = [](const app::SceneWindow& s) { return mrbsp::TerrainWindow{s.window.cells, s.xs, s.ys, s.z}; };
+
+  std::vector<double> build, slide;
+  std::unique_ptr<mrbsp::TerrainTree> tree;
+  const int reps = std::max(3, c.repeats);
+  for (int r = 0; r <= reps; ++r) {  // the first is a warm-up
+    const auto t0 = Clock::now();
+    tree = std::make_unique<mrbsp::TerrainTree>(view(a), levels);
+    if (r > 0) build.push_back(ms_since(t0));
+  }
+  for (int r = 0; r <= 2 * reps; ++r) {
+    const auto t0 = Clock::now();
+    tree->slide(view(r % 2 ? a : b));
+    if (r > 0) slide.push_back(ms_since(t0));
+  }
+  const mrbsp::MemoryStats m = tree->memory();
+  const double samples = static_cast<double>(m.samples);
+  json out;
+  out["terrain"] = terrain.name;
+  out["window_cells"] = w0.cells;
+  out["levels"] = levels;
+  out["samples"] = m.samples;
+  out["build_ms"] = to_json(summarize(build));
+  out["slide_ms"] = to_json(summarize(slide));
+  out["build_over_slide"] = summarize(build).median / summarize(slide).median;
+  out["build_samples_per_s"] = samples / (summarize(build).median / 1000.0);
+  out["bytes_per_sample"] = json{{"nodes", static_cast<double>(m.nodes) / samples},
+                             {"vertices", static_cast<double>(m.vertices) / samples},
+                             {"total", static_cast<double>(m.total()) / samples}};
+  return out;
+}
+
+}  // namespace terravol::bench

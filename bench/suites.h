@@ -1,0 +1,52 @@
+// The benchmark suites of `terravol bench` (docs/benchmarks.md). Each draws its scenes at
+// 1280x720 offscreen, warms up, repeats every timed frame, and measures the configurations it
+// compares side by side in one run (per view, one after the other), so that its ratios hold on
+// a noisy machine. Each returns its figures as JSON (medians and spreads: bench/stats.h).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/scenes.h"
+
+namespace terravol::bench {
+
+struct BenchConfig {
+  int width = 1280, height = 720;
+  int views = 60;          // views of each terrain flythrough (suite 1)
+  int volume_views = 8;    // views of each translucency orbit (suites 2, 5, 6)
+  int repeats = 3;         // timed repetitions of each frame, after one untimed warm-up
+  bool plain_largest = true;  // scaling: draw the largest terrain with plain VTK too (33 M triangles)
+  std::filesystem::path cache;  // RF volumes and generated tiles, kept between runs
+  std::function<void(const std::string&)> log;  // progress, one line at a time
+};
+
+// 1. Terrain: a flythrough (scenes.h, flythrough) over the terrain's 1024-cell window. Per view:
+// Terravol's full-resolution image (the quality reference), the full-resolution lattice drawn by
+// plain VTK (bench/plain_vtk.h: ordinary mapper, depth test, geometry uploaded once), and the
+// MRBSP at thresholds 0.5, 1, 2, 4 of both metrics (the area metric's threshold is 250 t square
+// pixels, so that t = 2 is its default of 500): traversal, upload and draw times, triangles,
+// PSNR, SSIM and the share of pixels off by more than 8/255 against the reference.
+nlohmann::json terrain_suite(const BenchConfig& config, const Terrain& terrain);
+
+// 2, 5 and 6 on one three-volume scene (scenes.h): per view of an orbit around the volumes,
+// the same traversal drawn in the tree's order (bsp), by VTK's depth peeling with 4 peels and
+// with no limit (exact: the reference), and by VTK's default translucency; then the pipeline a
+// ParaView user would build: the full-resolution lattice and the undecimated isosurfaces and
+// slice drawn by plain VTK with 4 peels and with no limit. Then the responsiveness: time from
+// a threshold change, and from a slice move, to the next finished frame. And the merge figures.
+nlohmann::json translucency_suite(const BenchConfig& config, const Terrain& terrain,
+                                  const std::vector<volume::Transmitter>& transmitters);
+
+// 3. Scaling: one view (2500 m above the window's centre, pitch -20) of each terrain in its
+// largest window (at most 4096 cells): MRBSP at 1 px and plain VTK at full resolution.
+nlohmann::json scaling_suite(const BenchConfig& config, const std::vector<Terrain>& terrains);
+
+// 4. Build and slide of the tree of a 1024-cell window (no rendering): build time, slide time
+// (by one coarsest cell east and back), their ratio, samples per second, bytes per sample.
+nlohmann::json build_suite(const BenchConfig& config, const Terrain& terrain);
+
+}  // namespace terravol::bench

@@ -1,0 +1,67 @@
+// `terravol bench` as a user runs it: a small run on the bundled DEM writes its JSON, report and
+// plots; bad options fail with one line.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "require_display.h"
+#include "run_command.h"
+
+namespace terravol {
+namespace {
+
+using test::run_terravol;
+
+TEST(BenchCli, UnknownSuiteOrMissingDemFailsWithOneLine) {
+  test::TempDir dir;
+  auto r = run_terravol("bench --suites terrain,fast -o " + dir.path().string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("unknown suite 'fast'"), std::string::npos) << r.err;
+  r = run_terravol("bench --suites build --dem /nonexistent/N00E000.hgt -o " + dir.path().string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("/nonexistent/N00E000.hgt: no such file"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "report.md"));
+}
+
+TEST(BenchCli, ASmallRunOnTheBundledDemWritesResultsReportAndPlots) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const std::string dem = std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt";
+  const auto r = run_terravol("bench --suites build,terrain --views 2 --repeats 1 --dem " + dem + " -o " +
+                                  dir.path().string(),
+                              300);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("full-res VTK / MRBSP at 1 px, N45E006: "), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("terrain N45E006: view 2/2"), std::string::npos) << "progress on stderr: " << r.err;
+
+  std::ifstream in(dir.path() / "results.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& t = j["terrain"][0];
+  EXPECT_EQ(t["views"], 2);
+  EXPECT_EQ(t["mrbsp"].size(), 8u) << "4 thresholds x 2 metrics";
+  // Plain VTK draws every triangle of the 1024-cell window; the MRBSP at 1 px far fewer.
+  EXPECT_EQ(t["plain_vtk"]["triangles"].get<double>(), 2.0 * 1024 * 1024);
+  for (const auto& k : t["mrbsp"]) {
+    EXPECT_LT(k["triangles"]["median"].get<double>(), 2.0 * 1024 * 1024);
+    EXPECT_GT(k["psnr_db"]["median"].get<double>(), 20.0);
+    EXPECT_GT(k["ssim"]["median"].get<double>(), 0.5);
+  }
+  // Coarser thresholds draw fewer triangles.
+  EXPECT_GT(t["mrbsp"][0]["triangles"]["median"].get<double>(), t["mrbsp"][3]["triangles"]["median"].get<double>());
+  const auto& b = j["build"][0];
+  EXPECT_GT(b["build_over_slide"].get<double>(), 1.0) << "a slide reuses the node structure";
+  EXPECT_GT(b["bytes_per_sample"]["total"].get<double>(), 0.0);
+
+  std::ifstream md(dir.path() / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("## 1. Terrain flythrough"), std::string::npos);
+  EXPECT_NE(report.find("## 4. Build and slide"), std::string::npos);
+  for (const char* plot : {"plot-frame-time-N45E006.png", "plot-triangles-threshold.png", "plot-error-threshold.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / plot)) << plot;
+    EXPECT_NE(report.find(plot), std::string::npos) << plot;
+  }
+}
+
+}  // namespace
+}  // namespace terravol
