@@ -1,6 +1,7 @@
 // app/terrain_renderer.h and app/ordered_mapper.h on a tiny scene of their own: the draw order
 // of the triangle list decides visibility under --order bsp, the depth buffer under zbuffer.
 #include <gtest/gtest.h>
+#include <vtkPolyData.h>
 
 #include <vector>
 
@@ -91,6 +92,47 @@ TEST(TerrainRenderer, EmptyFrameShowsTheBackground) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
   EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, {}), (test::Rgb8{0, 255, 0}));
+}
+
+// A slide frees the renderer's vertices (and their GPU buffers) before the tree merges again,
+// then gives it the new ones, which may be more.
+TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  for (DrawOrder order : {DrawOrder::kBsp, DrawOrder::kSort}) {
+    TwoSquares s = two_squares(255);
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.order = order;
+    settings.gradient = false;
+    settings.background = {0, 255, 0};
+    TerrainRenderer renderer(s.positions, s.shading, settings);
+    renderer.set_camera(s.camera, 100.0);
+    renderer.set_frame(frame_of(kFarThenNear));
+    renderer.render();
+    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{255, 0, 0}));
+
+    renderer.release_vertices();
+    EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 0);
+    EXPECT_EQ(renderer.scene()->GetNumberOfCells(), 0);
+    renderer.render();
+    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{0, 255, 0}));
+
+    // Four more vertices: a white square at z = 8, drawn last.
+    for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
+      s.positions.emplace_back(x, y, 8.0f);
+      s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
+      s.shading.shade.push_back(1.0f);
+      s.shading.rgba.push_back(Rgba{255, 255, 255, 255});
+    }
+    renderer.replace_vertices(s.positions, s.shading);
+    EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 12);
+    std::vector<std::uint32_t> three = kFarThenNear;
+    three.insert(three.end(), {8, 9, 10, 8, 10, 11});
+    renderer.set_frame(frame_of(three));
+    renderer.render();
+    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{255, 255, 255}));
+  }
 }
 
 }  // namespace
