@@ -250,19 +250,15 @@ void TerrainRenderer::set_camera(const mrbsp::Camera& camera, double far_plane) 
   apply_camera(camera, far_plane, *renderer_->GetActiveCamera());
 }
 
-namespace {
-
-vtkNew<vtkCellArray> triangle_cells(const std::vector<std::uint32_t>& indices) {
+vtkSmartPointer<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indices) {
   vtkNew<vtkTypeInt32Array> connectivity;
   connectivity->SetNumberOfValues(static_cast<vtkIdType>(indices.size()));
   std::int32_t* out = connectivity->GetPointer(0);
   for (std::size_t k = 0; k < indices.size(); ++k) out[k] = static_cast<std::int32_t>(indices[k]);
-  vtkNew<vtkCellArray> polys;
+  auto polys = vtkSmartPointer<vtkCellArray>::New();
   polys->SetData(3, connectivity);
   return polys;
 }
-
-}  // namespace
 
 void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   // The split orders draw the merged triangles with a second actor: the terrain's list keeps

@@ -21,6 +21,7 @@
 #include "mrbsp/terrain_tree.h"
 
 class vtkActor;
+class vtkCellArray;
 class vtkCamera;
 class vtkImageData;
 class vtkPolyData;
@@ -72,6 +73,11 @@ struct ColorTexture {
   int side = 0;                // n + 1; 0: no texture, per-vertex colours
   std::span<const Rgba> rgba;  // side * side
 };
+
+// Index triples as a vtkCellArray of triangles with 32-bit connectivity (offsets 0, 3, 6, ...),
+// the form the ordered mapper uploads as its index buffer without a copy. Precondition: every
+// index fits an int32 (VTK's 32-bit connectivity).
+vtkSmartPointer<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indices);
 
 // Throws std::runtime_error (one line, naming $DISPLAY and xvfb-run) when no X display can be
 // opened: VTK 9.1 on Debian renders through GLX even offscreen, and aborts without a display.

@@ -58,17 +58,6 @@ void check_triangles(std::span<const std::uint32_t> triangles, std::size_t verti
   }
 }
 
-// Triangles as a vtkCellArray with 32-bit connectivity (offsets 0, 3, 6, ...).
-vtkNew<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indices) {
-  vtkNew<vtkTypeInt32Array> connectivity;
-  connectivity->SetNumberOfValues(static_cast<vtkIdType>(indices.size()));
-  std::int32_t* out = connectivity->GetPointer(0);
-  for (std::size_t k = 0; k < indices.size(); ++k) out[k] = static_cast<std::int32_t>(indices[k]);
-  vtkNew<vtkCellArray> polys;
-  polys->SetData(3, connectivity);
-  return polys;
-}
-
 vtkNew<vtkUnsignedCharArray> rgba_array(const void* data, std::size_t count) {
   vtkNew<vtkUnsignedCharArray> rgba;
   rgba->SetName("rgba");
@@ -157,7 +146,7 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
   terrain_points->SetData(xyz);
   terrain_->SetPoints(terrain_points);
   terrain_->GetPointData()->SetScalars(rgba_array(terrain_rgba.data(), terrain_rgba.size()));
-  terrain_->SetPolys(triangle_cells(terrain_triangles));
+  terrain_->SetPolys(app::triangle_cells(terrain_triangles));
   terrain_mapper_->SetInputData(terrain_);
   setup_unlit(*terrain_mapper_, *terrain_actor_);
   terrain_actor_->ForceOpaqueOn();  // the opaque pass, depth-tested, whatever the alpha says
@@ -174,7 +163,7 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
     overlay_points->SetData(dxyz);
     overlay_->SetPoints(overlay_points);
     overlay_->GetPointData()->SetScalars(rgba_array(overlay_rgba.data(), overlay_rgba.size()));
-    overlay_->SetPolys(triangle_cells(overlay_triangles));
+    overlay_->SetPolys(app::triangle_cells(overlay_triangles));
     overlay_mapper_->SetInputData(overlay_);
     setup_unlit(*overlay_mapper_, *overlay_actor_);
     overlay_actor_->ForceTranslucentOn();
