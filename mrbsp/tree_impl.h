@@ -63,8 +63,8 @@ struct TerrainTree::Impl {
   std::vector<float> level0_error;  // per level-0 cell: the largest error of any cell inside it
 
   // Merged polygons (merge.cpp). The inputs are kept so that slide() can merge them again.
-  // Every merge releases what the one before held and leaves each container at the size it
-  // needs (no growth slack), so memory follows the current merge, not the largest so far.
+  // Every merge leaves each container at the size it needs (no growth slack), so memory
+  // follows the current merge, not the largest so far.
   // The merged vertices are kept once, as floats in `positions`: their double copies, which
   // classification needs, live only while a merge runs.
   std::vector<glm::dvec3> merge_input_positions;
