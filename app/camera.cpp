@@ -63,6 +63,10 @@ mrbsp::Camera make_scene_camera(const io::SceneFrame& frame, const CameraPose& p
   const glm::dvec3 level = std::sin(h) * east + std::cos(h) * north;  // horizontal, along the heading
   c.forward = glm::normalize(std::cos(p) * level + std::sin(p) * up);
   c.up = glm::normalize(std::cos(p) * up - std::sin(p) * level);
+  if (pose.roll_deg != 0.0) {
+    const double roll = pose.roll_deg * kDegree;
+    c.up = glm::normalize(std::cos(roll) * c.up + std::sin(roll) * glm::cross(c.forward, c.up));
+  }
   c.fov_y_deg = fov_y_deg;
   c.width = width;
   c.height = height;

@@ -18,6 +18,8 @@ struct CameraPose {
   double alt = 0.0;          // metres in the DEM's vertical datum, or above ground (--agl)
   double heading_deg = 0.0;  // degrees clockwise from north (0 north, 90 east); any value
   double pitch_deg = 0.0;    // degrees above the local horizon, [-90, 90] (-90 looks straight down)
+  double roll_deg = 0.0;     // degrees, banking right: the view's up turns toward its right about
+                             // the view direction; any value (camera paths: [-180, 180])
 };
 
 // Parses "LAT,LON,ALT,HEADING,PITCH" (five decimal numbers, no spaces required or allowed

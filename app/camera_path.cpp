@@ -413,7 +413,7 @@ PathSample CameraPath::at(double t) const {
   out.pose.lat = frame_.lat_of_y(p.y);
   out.pose.lon = frame_.lon_of_x(p.x);
   out.pose.alt = p.z;
-  angles_of(q, out.pose.heading_deg, out.pose.pitch_deg, out.roll_deg);
+  angles_of(q, out.pose.heading_deg, out.pose.pitch_deg, out.pose.roll_deg);
   out.fov_y_deg = hermite(times_, fov_, fov_slope_, tau);
   out.threshold = hermite(times_, threshold_, threshold_slope_, tau);
   return out;

@@ -80,8 +80,8 @@ nlohmann::json path_to_json(const nlohmann::json& scene, const std::vector<PathK
 
 // The camera at one instant.
 struct PathSample {
-  CameraPose pose;        // alt: above the ground when CameraPath::agl(), else in the datum
-  double roll_deg = 0.0;  // banking right, [-180, 180]
+  CameraPose pose;        // alt: above the ground when CameraPath::agl(), else in the datum;
+                          // roll_deg within [-180, 180]
   double fov_y_deg = 45.0;
   double threshold = 0.0;  // pixels
 };

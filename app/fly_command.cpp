@@ -92,12 +92,6 @@ std::string keys_around(const std::vector<PathKey>& keys, double t) {
 void run_fly(const FlyOptions& o) {
   const std::string source = o.path.string();
   const CameraPathFile file = load_camera_path(o.path);
-  for (std::size_t i = 0; i < file.keys.size(); ++i) {
-    if (file.keys[i].roll_deg != 0.0) {
-      throw std::invalid_argument(source + ": keys[" + std::to_string(i) +
-                                  "].roll: the renderer does not draw a rolled camera yet; remove it");
-    }
-  }
   SceneSpec scene = file.scene_file.empty() ? parse_scene_json(file.scene, file.base_dir, source + ": scene")
                                             : load_scene_file(file.scene_file);
   if (scene.dems.empty()) throw std::invalid_argument(source + ": scene: no \"dem\"; the flight needs terrain");

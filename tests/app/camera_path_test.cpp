@@ -175,7 +175,7 @@ glm::dvec3 forward_of(const PathSample& s) {
   return {std::sin(h) * std::cos(p), std::cos(h) * std::cos(p), std::sin(p)};
 }
 glm::dvec3 up_of(const PathSample& s) {
-  const double h = s.pose.heading_deg * kDeg, p = s.pose.pitch_deg * kDeg, r = s.roll_deg * kDeg;
+  const double h = s.pose.heading_deg * kDeg, p = s.pose.pitch_deg * kDeg, r = s.pose.roll_deg * kDeg;
   const glm::dvec3 level(std::sin(h), std::cos(h), 0.0), east(std::cos(h), -std::sin(h), 0.0);
   const glm::dvec3 up0 = std::cos(p) * glm::dvec3(0, 0, 1) - std::sin(p) * level;
   return std::cos(r) * up0 + std::sin(r) * east;
@@ -218,7 +218,7 @@ TEST(CameraPath, PassesThroughEveryKeyAtItsTime) {
     EXPECT_NEAR(s.pose.alt, k.alt, 1e-6);
     EXPECT_NEAR(std::remainder(s.pose.heading_deg - k.heading_deg, 360.0), 0.0, 1e-6);
     EXPECT_NEAR(s.pose.pitch_deg, k.pitch_deg, 1e-6);
-    EXPECT_NEAR(s.roll_deg, k.roll_deg, 1e-6);
+    EXPECT_NEAR(s.pose.roll_deg, k.roll_deg, 1e-6);
     EXPECT_NEAR(s.fov_y_deg, *k.fov_y_deg, 1e-9);
     EXPECT_NEAR(s.threshold, 2.0, 1e-12);
   }

@@ -59,6 +59,22 @@ TEST(SceneCamera, UpIsUnitAndOrthogonalToForward) {
     }
 }
 
+TEST(SceneCamera, RollBanksRightAboutTheViewDirection) {
+  const io::SceneFrame frame(45.0, 6.0);
+  CameraPose pose{45.0, 6.0, 1000.0, 90.0, -20.0};
+  const mrbsp::Camera level = make_scene_camera(frame, pose, 1000.0, 45.0, 640, 480, 1.0);
+  const glm::dvec3 right = glm::cross(level.forward, level.up);
+  pose.roll_deg = 90.0;
+  const mrbsp::Camera banked = make_scene_camera(frame, pose, 1000.0, 45.0, 640, 480, 1.0);
+  EXPECT_NEAR(glm::distance(banked.forward, level.forward), 0.0, 1e-12) << "roll keeps the view direction";
+  EXPECT_NEAR(glm::distance(banked.up, right), 0.0, 1e-12) << "at 90 degrees up is the old right";
+  pose.roll_deg = -30.0;
+  const mrbsp::Camera left = make_scene_camera(frame, pose, 1000.0, 45.0, 640, 480, 1.0);
+  EXPECT_NEAR(glm::dot(left.up, level.up), std::cos(30.0 * 3.14159265358979 / 180.0), 1e-12);
+  EXPECT_LT(glm::dot(left.up, right), 0.0) << "negative roll banks left";
+  EXPECT_NEAR(glm::length(left.up), 1.0, 1e-12);
+}
+
 TEST(SceneCamera, EyeDropsWithTheEarthsCurvatureLikeTheTerrain) {
   const io::SceneFrame frame(44.5, -71.5);
   const auto c = make_scene_camera(frame, {44.9, -71.1, 0, 0, 0}, 1500.0, 45.0, 640, 480, 1.0);

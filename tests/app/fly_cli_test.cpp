@@ -100,6 +100,37 @@ TEST(FlyCli, PngExportWritesEveryFrameOfThePath) {
   EXPECT_GE(std::stoi(row[18]), 1) << "the path should slide the 64-cell window";
 }
 
+// Share of sky pixels (blue well above red) in columns [x0, x1) of an image.
+double sky_share(const test::Image& img, int x0, int x1) {
+  int sky = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = x0; x < x1; ++x) sky += img.at(x, y)[2] > img.at(x, y)[0] + 30;
+  return static_cast<double>(sky) / ((x1 - x0) * img.height);
+}
+
+TEST(FlyCli, RollBanksTheViewSoTheSkyMovesToTheLeft) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  auto frame0 = [&](double roll, const std::string& name) {
+    json doc = flight(1.0);
+    for (auto& k : doc["keys"]) {
+      k["roll"] = roll;
+      k["pitch"] = 5;  // looking a little up: sky over the top half
+    }
+    const auto frames = dir.path() / name;
+    const auto r = run_terravol("fly " + write_path(dir, doc, name + ".json").string() + " -o " + frames.string() +
+                                "/ --fps 2 --size 160x90");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return test::read_png(frames / "frame_000000.png");
+  };
+  const test::Image level = frame0(0, "level"), banked = frame0(90, "banked");
+  ASSERT_EQ(banked.width, 160);
+  // Level: the sky is a band across the top, as much on the left as on the right.
+  EXPECT_NEAR(sky_share(level, 0, 50), sky_share(level, 110, 160), 0.15);
+  // Banked right by 90 degrees: the view's up is the old right, so the sky is on the left.
+  EXPECT_GT(sky_share(banked, 0, 50), sky_share(banked, 110, 160) + 0.25);  // measured 0.71 against 0.37
+}
+
 TEST(FlyCli, ResumingAnInterruptedExportGivesTheSameFrames) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;
@@ -218,8 +249,8 @@ TEST(FlyCli, BadPathFilesFailWithOneLineBeforeAnyFrame) {
   doc["scene"]["dem"] = "nowhere.hgt";
   expect_rejected(dir, doc.dump(), "nowhere.hgt: no such file");
   doc = flight();
-  doc["keys"][0]["roll"] = 10;
-  expect_rejected(dir, doc.dump(), "keys[0].roll: the renderer does not draw a rolled camera yet");
+  doc["keys"][0]["roll"] = 200;
+  expect_rejected(dir, doc.dump(), "bad.json: keys[0].roll: must be within [-180, 180], is 200");
   expect_rejected(dir, "{\"scene\": ", "bad.json: not valid JSON (byte 11)");
   expect_rejected(dir, flight().dump(), "--end 9.000: must be within --start .. 4.000 s", "--end 9");
   expect_rejected(dir, flight().dump(), "--samples 3: must be 1, 4, 9 or 16", "--samples 3");
