@@ -49,14 +49,19 @@ mrbsp::Frame frame_of(std::vector<std::uint32_t> indices) {
 const std::vector<std::uint32_t> kNearThenFar{0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
 const std::vector<std::uint32_t> kFarThenNear{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3};
 
-test::Rgb8 centre_pixel(const TwoSquares& s, DrawOrder order, const std::vector<std::uint32_t>& indices) {
+// 64 x 64 pixels on a uniform green background.
+RenderSettings two_squares_settings(DrawOrder order) {
   RenderSettings settings;
   settings.width = 64;
   settings.height = 64;
   settings.order = order;
   settings.gradient = false;
   settings.background = {0, 255, 0};
-  TerrainRenderer renderer(s.positions, s.shading, settings);
+  return settings;
+}
+
+test::Rgb8 centre_pixel(const TwoSquares& s, DrawOrder order, const std::vector<std::uint32_t>& indices) {
+  TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(order));
   renderer.set_camera(s.camera, 100.0);
   renderer.set_frame(frame_of(indices));
   renderer.render();
@@ -100,13 +105,7 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
   TERRAVOL_REQUIRE_DISPLAY();
   for (DrawOrder order : {DrawOrder::kBsp, DrawOrder::kSort}) {
     TwoSquares s = two_squares(255);
-    RenderSettings settings;
-    settings.width = 64;
-    settings.height = 64;
-    settings.order = order;
-    settings.gradient = false;
-    settings.background = {0, 255, 0};
-    TerrainRenderer renderer(s.positions, s.shading, settings);
+    TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(order));
     renderer.set_camera(s.camera, 100.0);
     renderer.set_frame(frame_of(kFarThenNear));
     renderer.render();

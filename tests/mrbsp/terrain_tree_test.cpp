@@ -14,6 +14,7 @@ namespace terravol::mrbsp {
 namespace {
 
 using test::order_violations;
+using test::SlidingTerrain;
 using test::TestWindow;
 
 Camera looking_down_from(double x, double y, double z) {
@@ -146,15 +147,8 @@ TEST(TerrainTree, RejectsBadWindowsAndLevels) {
 }
 
 TEST(TerrainTree, SlidingGivesTheSameFramesAsBuildingAnew) {
-  std::mt19937 rng(99);
-  std::uniform_real_distribution<float> h(0.0f, 300.0f);
-  std::vector<float> big(64 * 64);
-  for (float& v : big) v = h(rng);
-  auto window_at = [&](int ox, int oy) {
-    return TestWindow(16, [&](int i, int j) { return big[static_cast<std::size_t>((oy + j) * 64 + ox + i)]; },
-                      100.0 * ox, 100.0 * oy);
-  };
-  const TestWindow a = window_at(0, 0), b = window_at(8, 4);
+  const SlidingTerrain terrain(99);
+  const TestWindow a = terrain.window_at(0, 0), b = terrain.window_at(8, 4);
   TerrainTree slid(a.view(), 4);
   slid.slide(b.view());
   const TerrainTree fresh(b.view(), 4);

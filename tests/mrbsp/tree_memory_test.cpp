@@ -12,6 +12,7 @@
 namespace terravol::mrbsp {
 namespace {
 
+using test::SlidingTerrain;
 using test::TestWindow;
 
 // `count` random triangles through a window of 16 cells of 100 m (x and y in [-100, 1700]),
@@ -95,15 +96,8 @@ TEST(TerrainTreeMemory, ASmallMergeAfterALargeOneHoldsWhatItHoldsAlone) {
 // merged polygons merged again into the moved window take what they take in a tree built
 // there, not the larger of that and what the old window held.
 TEST(TerrainTreeMemory, SlidingKeepsNodesAndHoldsWhatATreeBuiltThereHolds) {
-  std::mt19937 rng(31);
-  std::uniform_real_distribution<float> h(0.0f, 300.0f);
-  std::vector<float> big(64 * 64);
-  for (float& v : big) v = h(rng);
-  auto window_at = [&](int ox, int oy) {
-    return TestWindow(16, [&](int i, int j) { return big[static_cast<std::size_t>((oy + j) * 64 + ox + i)]; },
-                      100.0 * ox, 100.0 * oy);
-  };
-  const TestWindow a = window_at(0, 0), b = window_at(24, 16);
+  const SlidingTerrain terrain(31);
+  const TestWindow a = terrain.window_at(0, 0), b = terrain.window_at(24, 16);
   // Triangles over the first window only: after the slide most of them lie outside the moved
   // window and are split by fewer of its planes.
   const Triangles s = random_triangles(9, 80);

@@ -29,6 +29,21 @@ struct TestWindow {
   TerrainWindow view() const { return {n, xs, ys, z}; }
 };
 
+// A 64 x 64-sample random terrain (heights uniform in [0, 300) m, fixed seed) to slide 16-cell
+// windows over: window_at(ox, oy) starts at sample (ox, oy), at (100 ox, 100 oy) metres.
+struct SlidingTerrain {
+  std::vector<float> big;
+  explicit SlidingTerrain(unsigned seed) : big(64 * 64) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> h(0.0f, 300.0f);
+    for (float& v : big) v = h(rng);
+  }
+  TestWindow window_at(int ox, int oy) const {
+    return TestWindow(16, [&](int i, int j) { return big[static_cast<std::size_t>((oy + j) * 64 + ox + i)]; },
+                      100.0 * ox, 100.0 * oy);
+  }
+};
+
 // Distance along the ray to the triangle, or a negative value when it misses (Moller-Trumbore).
 inline double ray_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
                     const glm::dvec3& c) {
