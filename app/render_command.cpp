@@ -197,20 +197,14 @@ void add_render_command(CLI::App& app) {
     // The scene file first; whatever the command line gave wins.
     const SceneSpec file = read_scene_args(raw->scene, opt.dems);
     const SceneStyle& st = file.style;
-    if (camera->count() > 0) {
-      opt.pose = parse_camera_pose(raw->camera);
-    } else if (file.camera) {
-      opt.pose = file.camera->pose;
-      opt.agl = opt.agl || file.camera->agl;
-      if (fov->count() == 0) opt.fov_y_deg = file.camera->fov_y_deg;
-    } else {
-      throw std::invalid_argument("--camera is required (or a \"camera\" in the scene file)");
-    }
+    const auto pose = resolve_camera(file, camera->count() > 0 ? &raw->camera : nullptr, fov->count() > 0, opt.agl,
+                                     opt.fov_y_deg);
+    if (!pose) throw std::invalid_argument("--camera is required (or a \"camera\" in the scene file)");
+    opt.pose = *pose;
     if (size->count() == 0 && st.width) raw->size = std::to_string(*st.width) + "x" + std::to_string(*st.height);
     if (metric->count() == 0 && st.lod_metric) raw->metric = *st.lod_metric;
     if (order->count() == 0 && st.order) raw->order = *st.order;
     if (tint->count() == 0 && st.tint) raw->tint = *st.tint;
-    if (threshold->count() == 0 && st.threshold) raw->threshold = *st.threshold;
     if (window->count() == 0 && st.window) opt.max_window = *st.window;
     if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
     if (sun_azimuth->count() == 0 && st.sun_azimuth) opt.shading.sun_azimuth_deg = *st.sun_azimuth;
@@ -227,22 +221,9 @@ void add_render_command(CLI::App& app) {
       opt.render.background = parse_rgb("--background", raw->background);
       opt.render.gradient = false;
     }
-    if (threshold->count() == 0 && !st.threshold) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
-    if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
-      throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
-    }
-    opt.traversal.threshold_px = static_cast<float>(raw->threshold);
+    opt.traversal.threshold_px = resolve_threshold(threshold->count() > 0, raw->threshold, st.threshold, opt.traversal.metric);
     opt.traversal.skirts = !opt.render.wireframe;  // skirts patch cracks in filled drawing only
-    if (!(opt.fov_y_deg > 0.0 && opt.fov_y_deg < 180.0)) {
-      throw std::invalid_argument("--fov " + std::to_string(opt.fov_y_deg) + ": must be within (0, 180) degrees");
-    }
-    if (opt.max_window < 2 || (opt.max_window & (opt.max_window - 1)) != 0) {
-      throw std::invalid_argument("--window " + std::to_string(opt.max_window) + ": must be a power of two >= 2");
-    }
-    if (!(opt.haze_km >= 0.0) || !std::isfinite(opt.haze_km)) {
-      throw std::invalid_argument("--haze: must be a distance >= 0 km");
-    }
-    if (levels->count() > 0 && opt.levels < 1) throw std::invalid_argument("--levels " + std::to_string(opt.levels) + ": must be >= 1");
+    check_view_options(opt.fov_y_deg, opt.max_window, opt.haze_km, levels->count() > 0, opt.levels);
     if (!(opt.shading.sun_elevation_deg > 0.0 && opt.shading.sun_elevation_deg <= 90.0)) {
       throw std::invalid_argument("--sun-elevation: must be within (0, 90] degrees");
     }

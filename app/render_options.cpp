@@ -1,6 +1,7 @@
 #include "app/render_options.h"
 
 #include <charconv>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -23,6 +24,34 @@ std::string quote(std::string_view option, std::string_view text) {
 }
 
 }  // namespace
+
+std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::string* camera_text, bool fov_given,
+                                         bool& agl, double& fov_y_deg) {
+  if (camera_text != nullptr) return parse_camera_pose(*camera_text);
+  if (!file.camera) return std::nullopt;
+  agl = agl || file.camera->agl;
+  if (!fov_given) fov_y_deg = file.camera->fov_y_deg;
+  return file.camera->pose;
+}
+
+float resolve_threshold(bool given, double option, const std::optional<double>& file, mrbsp::LodMetric metric) {
+  const double t = given ? option : file ? *file : mrbsp::default_threshold(metric);
+  if (!(t > 0.0) || !std::isfinite(t)) {
+    throw std::invalid_argument("--threshold " + std::to_string(t) + ": must be a positive number of pixels");
+  }
+  return static_cast<float>(t);
+}
+
+void check_view_options(double fov_y_deg, int max_window, double haze_km, bool levels_given, int levels) {
+  if (!(fov_y_deg > 0.0 && fov_y_deg < 180.0)) {
+    throw std::invalid_argument("--fov " + std::to_string(fov_y_deg) + ": must be within (0, 180) degrees");
+  }
+  if (max_window < 2 || (max_window & (max_window - 1)) != 0) {
+    throw std::invalid_argument("--window " + std::to_string(max_window) + ": must be a power of two >= 2");
+  }
+  if (!(haze_km >= 0.0) || !std::isfinite(haze_km)) throw std::invalid_argument("--haze: must be a distance >= 0 km");
+  if (levels_given && levels < 1) throw std::invalid_argument("--levels " + std::to_string(levels) + ": must be >= 1");
+}
 
 void parse_size(std::string_view text, int& width, int& height) {
   const std::size_t x = text.find('x');

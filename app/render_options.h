@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -56,6 +57,22 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args);
 // --slice lists replace the styles of every volume of the file. Throws std::invalid_argument
 // for a bad file or bad --iso, --slice or --volume-frame text.
 SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
+
+// The camera `render` and `view` start from: --camera TEXT when given (camera_text not null),
+// else the scene file's camera, whose agl is or-ed into `agl` and whose field of view replaces
+// `fov_y_deg` unless --fov was given; nothing when neither has one. Throws what
+// parse_camera_pose throws.
+std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::string* camera_text, bool fov_given,
+                                         bool& agl, double& fov_y_deg);
+
+// The LOD threshold: --threshold when given, else the scene file's, else the metric's default.
+// Throws std::invalid_argument unless it is a positive finite number of pixels.
+float resolve_threshold(bool given, double option, const std::optional<double>& file, mrbsp::LodMetric metric);
+
+// Throws std::invalid_argument naming --fov, --window, --haze or --levels when the field of
+// view is not within (0, 180) degrees, the window not a power of two >= 2, the haze distance
+// not >= 0 km, or levels (when given) < 1.
+void check_view_options(double fov_y_deg, int max_window, double haze_km, bool levels_given, int levels);
 
 // "WxH", each 1..16384.
 void parse_size(std::string_view text, int& width, int& height);

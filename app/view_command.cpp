@@ -62,17 +62,11 @@ void add_view_command(CLI::App& app) {
     const SceneSpec file = read_scene_args(raw->scene, opt.dems);
     opt.scene_file = raw->scene.scene;
     const SceneStyle& st = file.style;
-    if (camera->count() > 0) {
-      opt.pose = parse_camera_pose(raw->camera);
-    } else if (file.camera) {
-      opt.pose = file.camera->pose;
-      opt.agl = opt.agl || file.camera->agl;
-      if (fov->count() == 0) opt.fov_y_deg = file.camera->fov_y_deg;
-    }
+    opt.pose = resolve_camera(file, camera->count() > 0 ? &raw->camera : nullptr, fov->count() > 0, opt.agl,
+                              opt.fov_y_deg);
     if (size->count() == 0 && st.width) raw->size = std::to_string(*st.width) + "x" + std::to_string(*st.height);
     if (metric->count() == 0 && st.lod_metric) raw->metric = *st.lod_metric;
     if (tint->count() == 0 && st.tint) raw->tint = *st.tint;
-    if (threshold->count() == 0 && st.threshold) raw->threshold = *st.threshold;
     if (window->count() == 0 && st.window) opt.max_window = *st.window;
     if (haze->count() == 0 && st.haze_km) opt.haze_km = *st.haze_km;
     opt.legend = !raw->scene.no_legend && st.legend.value_or(true);
@@ -81,22 +75,11 @@ void add_view_command(CLI::App& app) {
     opt.traversal.metric = parse_metric(raw->metric);
     opt.shading.tint = parse_tint(raw->tint);
     opt.auto_slide = !raw->no_slide;
-    if (threshold->count() == 0 && !st.threshold) raw->threshold = mrbsp::default_threshold(opt.traversal.metric);
-    if (!(raw->threshold > 0.0) || !std::isfinite(raw->threshold)) {
-      throw std::invalid_argument("--threshold " + std::to_string(raw->threshold) + ": must be a positive number of pixels");
-    }
-    opt.traversal.threshold_px = static_cast<float>(raw->threshold);
-    if (!(opt.fov_y_deg > 0.0 && opt.fov_y_deg < 180.0)) {
-      throw std::invalid_argument("--fov " + std::to_string(opt.fov_y_deg) + ": must be within (0, 180) degrees");
-    }
-    if (opt.max_window < 2 || (opt.max_window & (opt.max_window - 1)) != 0) {
-      throw std::invalid_argument("--window " + std::to_string(opt.max_window) + ": must be a power of two >= 2");
-    }
-    if (!(opt.haze_km >= 0.0) || !std::isfinite(opt.haze_km)) throw std::invalid_argument("--haze: must be a distance >= 0 km");
+    opt.traversal.threshold_px = resolve_threshold(threshold->count() > 0, raw->threshold, st.threshold, opt.traversal.metric);
+    check_view_options(opt.fov_y_deg, opt.max_window, opt.haze_km, levels->count() > 0, opt.levels);
     if (!(opt.flight.speed_factor > 0.0) || !std::isfinite(opt.flight.speed_factor)) {
       throw std::invalid_argument("--speed: must be a positive number");
     }
-    if (levels->count() > 0 && opt.levels < 1) throw std::invalid_argument("--levels " + std::to_string(opt.levels) + ": must be >= 1");
     if (opt.agl && !opt.pose) throw std::invalid_argument("--agl needs --camera");
     run_viewer(opt);
   });

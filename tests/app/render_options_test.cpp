@@ -33,5 +33,30 @@ TEST(RenderOptions, NamedValues) {
   EXPECT_THROW(parse_tint("sepia"), std::invalid_argument);
 }
 
+TEST(RenderOptions, ThresholdComesFromTheOptionThenTheSceneFileThenTheMetric) {
+  EXPECT_EQ(resolve_threshold(true, 3.0, 5.0, mrbsp::LodMetric::kError), 3.0f);
+  EXPECT_EQ(resolve_threshold(false, 3.0, 5.0, mrbsp::LodMetric::kError), 5.0f);
+  EXPECT_EQ(resolve_threshold(false, 3.0, std::nullopt, mrbsp::LodMetric::kArea), 500.0f);
+  EXPECT_THROW(resolve_threshold(true, 0.0, std::nullopt, mrbsp::LodMetric::kError), std::invalid_argument);
+  EXPECT_THROW(resolve_threshold(false, 1.0, -2.0, mrbsp::LodMetric::kError), std::invalid_argument);
+}
+
+TEST(RenderOptions, CameraComesFromTheOptionElseTheSceneFileWithItsAglAndFov) {
+  SceneSpec file;
+  bool agl = false;
+  double fov = 45.0;
+  EXPECT_FALSE(resolve_camera(file, nullptr, false, agl, fov));
+  file.camera = SceneCamera{CameraPose{45.2, 6.3, 500.0, 10.0, -5.0}, true, 60.0};
+  const std::string text = "45.1,6.1,2000,90,-10";
+  EXPECT_EQ(resolve_camera(file, &text, false, agl, fov)->alt, 2000.0);
+  EXPECT_FALSE(agl);
+  EXPECT_EQ(fov, 45.0);
+  EXPECT_EQ(resolve_camera(file, nullptr, true, agl, fov)->alt, 500.0);
+  EXPECT_TRUE(agl);
+  EXPECT_EQ(fov, 45.0) << "--fov given wins";
+  EXPECT_EQ(resolve_camera(file, nullptr, false, agl, fov)->lat, 45.2);
+  EXPECT_EQ(fov, 60.0);
+}
+
 }  // namespace
 }  // namespace terravol::app
