@@ -506,6 +506,15 @@ std::uint64_t touched(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
   return rect_mask(i0, i1, j0, j1);
 }
 
+// The children of that cell lying wholly inside the box.
+std::uint64_t contained(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
+  const i64 s = i64{1} << sh;
+  const i64 i0 = std::max<i64>(0, ceil_div(x0 - ox, s)), i1 = std::min<i64>(7, floor_div(x1 + 1 - ox, s) - 1);
+  const i64 j0 = std::max<i64>(0, ceil_div(y0 - oy, s)), j1 = std::min<i64>(7, floor_div(y1 + 1 - oy, s) - 1);
+  if (i0 > i1 || j0 > j1) return 0;
+  return rect_mask(static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0), static_cast<int>(j1));
+}
+
 }  // namespace
 
 // Whether every pixel of tile (tx, ty), rows j0..j1, that lies in the dilated polygon is
@@ -513,13 +522,16 @@ std::uint64_t touched(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
 bool Pyramid::hidden_tile(int tx, int ty, const Edges& E, const std::uint8_t* act, int n, int j0, int j1) {
   ++stats_.cells_visited;
   ++stats_.hidden_cells_visited;
-  const std::uint64_t cand = tile_mask(E, act, n, static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~tile(tx, ty);
+  // The offset polygon's uncovered pixels, within the dilated bounding box (beyond it every
+  // centre is farther than the dilation; the offset polygon's mitred corners may reach there).
+  const i64 ox = static_cast<i64>(tx) * 8, oy = static_cast<i64>(ty) * 8;
+  const std::uint64_t cand = tile_mask(E, act, n, ox, oy, j0, j1) & ~tile(tx, ty) & touched(ox, oy, 0, E.x0, E.x1, E.y0, E.y1);
   if (!cand) return true;
   // Uncovered pixels of the offset polygon: visible unless a rounded corner cuts them all away.
   std::uint64_t near_corner = 0;
   for (int q = 0; q < E.corners; ++q) {
     const Corner& k = E.corner[static_cast<std::size_t>(q)];
-    near_corner |= touched(static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, 0, k.x0, k.x1, k.y0, k.y1);
+    near_corner |= touched(ox, oy, 0, k.x0, k.x1, k.y0, k.y1);
   }
   if (cand & ~near_corner) return false;
   for (std::uint64_t bits = cand; bits; bits &= bits - 1) {
@@ -555,8 +567,11 @@ bool Pyramid::hidden_cell(int level, int cx, int cy, const Edges& E, const std::
     outside |= ~mask64(v.f + v.hi, s * a, s * b);
     act[static_cast<std::size_t>(n++)] = static_cast<std::uint8_t>(e);
   }
-  // A child wholly inside the offset polygon and clear of every corner's cut box lies wholly in
-  // the dilated polygon.
+  // Children beyond the dilated bounding box hold no pixel of the dilated polygon. A child wholly
+  // inside the offset polygon and the box, and clear of every corner's cut box, lies wholly in
+  // it.
+  outside |= ~touched(ox, oy, sh, E.x0, E.x1, E.y0, E.y1);
+  inside &= contained(ox, oy, sh, E.x0, E.x1, E.y0, E.y1);
   for (int q = 0; q < E.corners; ++q) {
     const Corner& k = E.corner[static_cast<std::size_t>(q)];
     inside &= ~touched(ox, oy, sh, k.x0, k.x1, k.y0, k.y1);
@@ -654,7 +669,8 @@ bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
     if (nh < 3) continue;  // the cut of a disc or a capsule's end is bounded by the box alone
     // The cut lies in the mitre quadrilateral v, v + D n1, v + D (n1 + n2) / (1 + n1.n2),
     // v + D n2 (n1, n2 the unit outward normals of the edges in and out of v). Its bounds in
-    // double, widened by a pixel, are far looser than their rounding.
+    // double, widened by a pixel, are far looser than their rounding. Only their part inside
+    // the dilated bounding box matters: pixels beyond it are outside anyway.
     const glm::dvec2 vp(static_cast<double>(v.x) / u_px, static_cast<double>(v.y) / u_px);
     const glm::dvec2 ein(static_cast<double>(-c.px), static_cast<double>(-c.py)), eout(static_cast<double>(c.nx), static_cast<double>(c.ny));
     const glm::dvec2 n1 = glm::dvec2(ein.y, -ein.x) / std::hypot(ein.x, ein.y);
