@@ -8,6 +8,10 @@
 
 #include <glm/vec2.hpp>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "coverage/pyramid.h"
 
 namespace terravol::coverage::detail {
@@ -24,26 +28,70 @@ struct FixedPoint {
   bool operator==(const FixedPoint&) const = default;
 };
 
-// Snaps window coordinates (pixels) to 1/256 px, nearest with ties to even (the default
-// rounding mode, as llvmpipe's lrintf). False for a coordinate that is not finite or beyond
-// kMaxCoordinate.
+// Nearest integer, ties to even (the default rounding mode), for |x| < 2^62: one instruction
+// where SSE2 has it (llrint is a library call without -fno-math-errno).
+inline i64 round_even(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_si64(_mm_set_sd(x));
+#else
+  return std::llrint(x);
+#endif
+}
+
+// Snaps window coordinates (pixels) to 1/256 px, nearest with ties to even (as llvmpipe's
+// lrintf). False for a coordinate that is not finite or beyond kMaxCoordinate.
 inline bool snap(glm::dvec2 p, FixedPoint& out) {
   if (!(std::abs(p.x) <= kMaxCoordinate) || !(std::abs(p.y) <= kMaxCoordinate)) return false;
-  out.x = std::llrint(p.x * static_cast<double>(kSubpixel));
-  out.y = std::llrint(p.y * static_cast<double>(kSubpixel));
+  out.x = round_even(p.x * static_cast<double>(kSubpixel));
+  out.y = round_even(p.y * static_cast<double>(kSubpixel));
   return true;
 }
 
-// A distance in pixels as a whole number of 1/256 px, rounded up.
-inline i64 snap_distance_up(double px) { return static_cast<i64>(std::ceil(px * static_cast<double>(kSubpixel))); }
+// A distance in pixels (0 <= px <= kMaxMargin) as a whole number of 1/256 px, rounded up.
+inline i64 snap_distance_up(double px) {
+  const double u = px * static_cast<double>(kSubpixel);
+  const auto t = static_cast<i64>(u);
+  return t + (static_cast<double>(t) < u ? 1 : 0);
+}
 
-// floor(sqrt(n)) for 0 <= n < 2^120.
-inline i64 isqrt_floor(i128 n) {
-  if (n <= 0) return 0;
-  auto r = static_cast<i64>(std::sqrt(static_cast<double>(n)));
-  while (static_cast<i128>(r) * r > n) --r;
+// floor(m sqrt(a^2 + b^2)) for 0 <= m <= 2^16 and |a|, |b| <= 2^34, exactly: an estimate in
+// double, then corrected against m^2 (a^2 + b^2) in 128 bits.
+inline i64 scaled_length_floor(i64 m, i64 a, i64 b) {
+  if (m == 0) return 0;
+  const double fa = static_cast<double>(a), fb = static_cast<double>(b);
+  auto r = static_cast<i64>(static_cast<double>(m) * std::sqrt(fa * fa + fb * fb));
+  const i128 n = static_cast<i128>(m * m) * (static_cast<i128>(a) * a + static_cast<i128>(b) * b);
+  while (r > 0 && static_cast<i128>(r) * r > n) --r;
   while (static_cast<i128>(r + 1) * (r + 1) <= n) ++r;
   return r;
+}
+// Whether r is exactly m sqrt(a^2 + b^2).
+inline bool is_scaled_length(i64 r, i64 m, i64 a, i64 b) {
+  return static_cast<i128>(r) * r == static_cast<i128>(m * m) * (static_cast<i128>(a) * a + static_cast<i128>(b) * b);
+}
+
+// The edge threshold of cover(): the least integer t such that an edge function value E
+// (|d| times the distance into the edge, 1/256 px units) passes the test E > m |d|, or
+// E >= m |d| when the edge owns its centres (the fill rule), |d| = sqrt(a^2 + b^2). Estimated
+// in double; when the estimate lies too near an integer for its rounding error, decided in
+// 128-bit integers.
+inline i64 inner_threshold(i64 m, i64 a, i64 b, bool owned) {
+  if (m == 0) return owned ? 0 : 1;
+  const double fa = static_cast<double>(a), fb = static_cast<double>(b);
+  const double x = static_cast<double>(m) * std::sqrt(fa * fa + fb * fb);  // relative error < 5e-16
+  const auto r = static_cast<i64>(x);
+  const double frac = x - static_cast<double>(r), tol = 1e-15 * x + 1e-12;
+  if (frac > tol && frac < 1.0 - tol) return r + 1;  // m |d| is not an integer: ceil = floor + 1
+  const i64 f = scaled_length_floor(m, a, b);
+  return owned && is_scaled_length(f, m, a, b) ? f : f + 1;
+}
+
+inline int popcount64(std::uint64_t x) {
+  // Without -mpopcnt std::popcount is a library call; this is the usual SWAR count.
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
 }
 
 // (b - a) x (c - a): positive when a, b, c turn counterclockwise (y up).

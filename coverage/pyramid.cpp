@@ -54,8 +54,6 @@
 #include <emmintrin.h>
 #endif
 
-#include <glm/common.hpp>
-
 #include "coverage/fixed.h"
 
 namespace terravol::coverage {
@@ -71,10 +69,7 @@ namespace {
 constexpr std::uint64_t kAll = ~std::uint64_t{0};
 constexpr int kMaxEdges = kMaxVertices + 4;  // hidden() adds the box of a disc or capsule
 constexpr int kDirectTiles = 4;              // polygons within 4x4 tiles skip the triage levels
-constexpr double u_px = static_cast<double>(kSubpixel);  // 1/256 px units per pixel
 
-constexpr i64 floor_div(i64 n, i64 d) { return n >= 0 ? n / d : -((-n + d - 1) / d); }
-constexpr i64 ceil_div(i64 n, i64 d) { return -floor_div(-n, d); }
 
 // Rows j0..j1 (bytes j0..j1 of a mask) set.
 constexpr std::uint64_t row_mask(int j0, int j1) {
@@ -137,18 +132,82 @@ std::uint64_t mask32(i64 v, i64 sa, i64 sb, int j0, int j1) {
 #endif
 }
 
+// An edge of a small polygon on the pixel lattice: inside where a x + b y + c >= 0.
+struct SmallEdge {
+  i64 a, b, c;
+};
+
+// The edge q0 -> q1 of a small polygon of orientation sign (+1 counterclockwise), eroded by
+// margin (1/256 px); a repeated vertex gives an edge everything passes. With |a|, |b| < 2^15
+// and margin <= 2^16, m^2 (a^2 + b^2) < 2^63, so the threshold's exact check fits 64 bits.
+[[gnu::always_inline]] inline SmallEdge small_edge(FixedPoint q0, FixedPoint q1, i64 sign, i64 margin) {
+  const i64 a = -(q1.y - q0.y) * sign, b = (q1.x - q0.x) * sign;
+  if (a == 0 && b == 0) return {0, 0, 0};
+  const bool owned = a > 0 || (a == 0 && b > 0);
+  i64 t = owned ? 0 : 1;
+  if (margin > 0) {
+    // r = floor(m |d|), from an estimate off by less than one, then t as in inner_threshold.
+    const auto n = static_cast<std::uint64_t>(margin * margin) * static_cast<std::uint64_t>(a * a + b * b);
+    const double fa = static_cast<double>(a), fb = static_cast<double>(b);
+    auto r = static_cast<std::uint64_t>(static_cast<i64>(static_cast<double>(margin) * std::sqrt(fa * fa + fb * fb)));
+    if (r * r > n) --r;
+    if ((r + 1) * (r + 1) <= n) ++r;
+    t = static_cast<i64>(r) + (owned && r * r == n ? 0 : 1);
+  }
+  return {a, b, (a * (kHalfPixel - q0.x) + b * (kHalfPixel - q0.y) - t) >> detail::kSubpixelBits};  // floor
+}
+
+// The mask of pixels inside all N edges of a tile whose first pixel is (ox, oy), on rows
+// j0..j1, for values that fit in 32 bits over the tile: one pass, the edges' values OR-ed so
+// that one sign extraction tests them all.
+#if defined(__SSE2__)
+// The edges prepared for SIMD: columns 0..3 of a row hold c + a x + b y + (0, a, 2a, 3a).
+struct SmallLanes {
+  __m128i lane, four_a, step;
+};
+
+template <int N>
+[[gnu::always_inline]] inline std::uint64_t small_mask(const SmallEdge* e, const SmallLanes* l, i64 ox, i64 oy, int j0, int j1) {
+  __m128i lo[N], hi[N];
+  for (int k = 0; k < N; ++k) {
+    lo[k] = _mm_add_epi32(_mm_set1_epi32(static_cast<std::int32_t>(e[k].c + e[k].a * ox + e[k].b * (oy + j0))), l[k].lane);
+    hi[k] = _mm_add_epi32(lo[k], l[k].four_a);
+  }
+  std::uint64_t m = 0;
+  for (int j = j0; j <= j1; ++j) {
+    __m128i lo_or = lo[0], hi_or = hi[0];
+    for (int k = 1; k < N; ++k) {
+      lo_or = _mm_or_si128(lo_or, lo[k]);
+      hi_or = _mm_or_si128(hi_or, hi[k]);
+    }
+    const int neg = _mm_movemask_ps(_mm_castsi128_ps(lo_or)) | (_mm_movemask_ps(_mm_castsi128_ps(hi_or)) << 4);
+    m |= static_cast<std::uint64_t>(~neg & 0xFF) << (8 * j);
+    for (int k = 0; k < N; ++k) {
+      lo[k] = _mm_add_epi32(lo[k], l[k].step);
+      hi[k] = _mm_add_epi32(hi[k], l[k].step);
+    }
+  }
+  return m;
+}
+#else
+template <int N>
+std::uint64_t small_mask(const SmallEdge* e, i64 ox, i64 oy, int j0, int j1) {
+  std::uint64_t m = row_mask(j0, j1);
+  for (int k = 0; k < N; ++k) m &= mask64(e[k].c + e[k].a * ox + e[k].b * oy, e[k].a, e[k].b);
+  return m;
+}
+#endif
+
 }  // namespace
 
 // A rounded corner of hidden()'s dilated polygon: pixels of the offset polygon (every edge
 // moved out by the dilation) that lie in the vertex's normal cone farther than the dilation
-// from the vertex are outside the rounded region. They all lie in the box [x0, x1] x [y0, y1]
-// (pixels), the mitre quadrilateral's bounds.
+// from the vertex are outside the rounded region.
 struct Corner {
   FixedPoint v;              // the vertex, 1/256 px
   i64 px, py;                // previous vertex - v
   i64 nx, ny;                // next vertex - v
   bool whole_plane;          // a single point: its cone is the whole plane
-  int x0, x1, y0, y1;
 };
 
 // The polygon as edge functions on the pixel lattice: pixel (x, y) is inside edge k when
@@ -181,6 +240,23 @@ struct Pyramid::Edges {
     narrow = narrow && std::abs(ea) < (i64{1} << 26) && std::abs(eb) < (i64{1} << 26);
     ++n;
     return true;
+  }
+
+  // Whether pixel (x, y) lies in a corner's cut: in a vertex's normal cone, farther than the
+  // dilation from it (its nearest point of the polygon is the vertex, so it is outside the
+  // rounded region). Exact.
+  bool cut(int x, int y) const {
+    for (int q = 0; q < corners; ++q) {
+      const Corner& k = corner[static_cast<std::size_t>(q)];
+      const i64 tx = static_cast<i64>(x) * kSubpixel + kHalfPixel - k.v.x;
+      const i64 ty = static_cast<i64>(y) * kSubpixel + kHalfPixel - k.v.y;
+      if (!k.whole_plane) {
+        if (static_cast<i128>(tx) * k.px + static_cast<i128>(ty) * k.py > 0) continue;
+        if (static_cast<i128>(tx) * k.nx + static_cast<i128>(ty) * k.ny > 0) continue;
+      }
+      return static_cast<i128>(tx) * tx + static_cast<i128>(ty) * ty > static_cast<i128>(dilation) * dilation;
+    }
+    return false;
   }
 };
 
@@ -367,7 +443,7 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
   if (w) {
     m.c |= w;
     m.v &= ~w;
-    stats_.pixels_claimed += static_cast<std::uint64_t>(std::popcount(w)) * static_cast<std::uint64_t>(s * s);
+    stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(w)) * static_cast<std::uint64_t>(s * s);
     for (std::uint64_t bits = w; bits; bits &= bits - 1) {
       const int bit = std::countr_zero(bits);
       fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
@@ -383,7 +459,7 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
       const std::uint64_t nw = tile_mask(E, act.data(), n, static_cast<i64>(x) * 8, static_cast<i64>(y) * 8, 0, 7) & ~t;
       if (!nw) continue;
       t |= nw;
-      stats_.pixels_claimed += static_cast<std::uint64_t>(std::popcount(nw));
+      stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
       m.v &= ~b;
       if (t == kAll) m.c |= b;
     } else {
@@ -394,6 +470,119 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
     }
   }
 }
+
+// cover() for a triangle (N = 3) or a quad (N = 4) whose bounding box is under 128 px and
+// whose pixel range spans at most 2 x 2 tiles: the same exact predicate, in 64-bit arithmetic
+// (coordinates under 2^24 units, edge components under 2^15, so every product fits), all edges
+// tested in one SIMD pass per row.
+template <int N>
+void Pyramid::cover_small(const detail::FixedPoint* p, i64 margin, int x0, int x1, int y0, int y1) {
+  i64 area2 = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+  if constexpr (N == 4) area2 += (p[2].x - p[0].x) * (p[3].y - p[0].y) - (p[2].y - p[0].y) * (p[3].x - p[0].x);
+  if (area2 == 0) return;
+  const i64 sign = area2 > 0 ? 1 : -1;
+  std::array<SmallEdge, N> e;
+  e[0] = small_edge(p[0], p[1], sign, margin);
+  e[1] = small_edge(p[1], p[2], sign, margin);
+  if constexpr (N == 3) {
+    e[2] = small_edge(p[2], p[0], sign, margin);
+  } else {
+    e[2] = small_edge(p[2], p[3], sign, margin);
+    e[3] = small_edge(p[3], p[0], sign, margin);
+  }
+#if defined(__SSE2__)
+  std::array<SmallLanes, N> lanes;
+  for (int k = 0; k < N; ++k) {
+    const auto a = static_cast<std::int32_t>(e[k].a);
+    lanes[k] = {_mm_set_epi32(3 * a, 2 * a, a, 0), _mm_set1_epi32(4 * a), _mm_set1_epi32(static_cast<std::int32_t>(e[k].b))};
+  }
+#endif
+  const int tx0 = x0 >> 3, tx1 = x1 >> 3, ty0 = y0 >> 3, ty1 = y1 >> 3;
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    const int j0 = std::max(0, y0 - 8 * ty), j1 = std::min(7, y1 - 8 * ty);
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      std::uint64_t& t = tile(tx, ty);
+      if (t == kAll) continue;
+      ++stats_.cells_visited;
+#if defined(__SSE2__)
+      const std::uint64_t nw = small_mask<N>(e.data(), lanes.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
+#else
+      const std::uint64_t nw = small_mask<N>(e.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
+#endif
+      if (!nw) continue;
+      const bool was_empty = t == 0;
+      t |= nw;
+      stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
+      if (was_empty || t == kAll) propagate(0, tx, ty);
+    }
+  }
+}
+
+// cover() for a triangle whose pixel range holds at most 2 x 2 pixels (most distant terrain
+// triangles): each candidate centre tested against each edge directly, with the margin compared
+// squared (E^2 against m^2 (a^2 + b^2)), so no square root. With the bounding box under 128 px,
+// |E| < 2^31.2 and every square fits 64 bits unsigned.
+void Pyramid::cover_tiny(const detail::FixedPoint* p, i64 margin, int x0, int x1, int y0, int y1) {
+  const i64 area2 = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+  if (area2 == 0) return;
+  const i64 sign = area2 > 0 ? 1 : -1;
+  struct Edge {
+    i64 a, b, x, y;        // inward normal, and a point on the edge
+    std::uint64_t limit;   // m^2 (a^2 + b^2)
+    bool owned;
+  };
+  std::array<Edge, 3> e;
+  for (int i = 0; i < 3; ++i) {
+    const FixedPoint q0 = p[i], q1 = p[i == 2 ? 0 : i + 1];
+    const i64 a = -(q1.y - q0.y) * sign, b = (q1.x - q0.x) * sign;
+    e[static_cast<std::size_t>(i)] = {a, b, q0.x, q0.y, static_cast<std::uint64_t>(margin * margin) * static_cast<std::uint64_t>(a * a + b * b),
+                                      a > 0 || (a == 0 && b > 0)};
+  }
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      std::uint64_t& t = tile(x >> 3, y >> 3);
+      const std::uint64_t bit = std::uint64_t{1} << (8 * (y & 7) + (x & 7));
+      if (t & bit) continue;
+      ++stats_.cells_visited;
+      const i64 px = static_cast<i64>(x) * kSubpixel + kHalfPixel, py = static_cast<i64>(y) * kSubpixel + kHalfPixel;
+      bool inside = true;
+      for (const Edge& k : e) {
+        const i64 v = k.a * (px - k.x) + k.b * (py - k.y);  // |d| times the distance inside
+        const std::uint64_t v2 = static_cast<std::uint64_t>(v) * static_cast<std::uint64_t>(v);
+        inside = inside && v >= 0 && (v2 > k.limit || (v2 == k.limit && k.owned));
+      }
+      if (!inside) continue;
+      const bool was_empty = t == 0;
+      t |= bit;
+      ++stats_.pixels_claimed;
+      if (was_empty || t == kAll) propagate(0, x >> 3, y >> 3);
+    }
+  }
+}
+
+namespace {
+
+// Snaps N vertices (N > 0 known at compile time, or n at run time) and bounds them; false if one
+// is not finite or beyond kMaxCoordinate.
+struct Bounds {
+  i64 xmin, xmax, ymin, ymax;
+};
+template <int N>
+bool snap_all(const glm::dvec2* v, int n, FixedPoint* p, Bounds& b) {
+  const int count = N > 0 ? N : n;
+  if (!detail::snap(v[0], p[0])) return false;
+  b = {p[0].x, p[0].x, p[0].y, p[0].y};
+  for (int i = 1; i < count; ++i) {
+    if (!detail::snap(v[i], p[i])) return false;
+    b.xmin = std::min(b.xmin, p[i].x);
+    b.xmax = std::max(b.xmax, p[i].x);
+    b.ymin = std::min(b.ymin, p[i].y);
+    b.ymax = std::max(b.ymax, p[i].y);
+  }
+  return true;
+}
+
+}  // namespace
 
 void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
   if (!(margin_px >= 0.0 && margin_px <= kMaxMargin)) {
@@ -408,26 +597,45 @@ void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
   const int nv = static_cast<int>(polygon.size());
   if (nv < 3) return;
   std::array<FixedPoint, kMaxVertices> p;
-  i64 xmin = INT64_MAX, xmax = INT64_MIN, ymin = INT64_MAX, ymax = INT64_MIN;
-  for (int i = 0; i < nv; ++i) {
-    if (!detail::snap(polygon[static_cast<std::size_t>(i)], p[i])) return;
-    xmin = std::min(xmin, p[i].x);
-    xmax = std::max(xmax, p[i].x);
-    ymin = std::min(ymin, p[i].y);
-    ymax = std::max(ymax, p[i].y);
-  }
-  // A centre inside by more than the margin lies at least the margin inside the bounding box.
+  Bounds bb;
+  if (!(nv == 3 ? snap_all<3>(polygon.data(), nv, p.data(), bb) : snap_all<0>(polygon.data(), nv, p.data(), bb))) return;
+  const auto [xmin, xmax, ymin, ymax] = bb;
+  // A centre inside by more than the margin lies at least the margin inside the bounding box
+  // (pixel x has its centre at 256 x + 128 units).
   const i64 margin = detail::snap_distance_up(margin_px);
+  const int x0 = static_cast<int>(std::max<i64>(0, (xmin + margin - kHalfPixel + kSubpixel - 1) >> detail::kSubpixelBits));
+  const int x1 = static_cast<int>(std::min<i64>(width_ - 1, (xmax - margin - kHalfPixel) >> detail::kSubpixelBits));
+  const int y0 = static_cast<int>(std::max<i64>(0, (ymin + margin - kHalfPixel + kSubpixel - 1) >> detail::kSubpixelBits));
+  const int y1 = static_cast<int>(std::min<i64>(height_ - 1, (ymax - margin - kHalfPixel) >> detail::kSubpixelBits));
+  if (x0 > x1 || y0 > y1) return;
+  constexpr i64 kSmall = i64{1} << 15, kNear = i64{1} << 24;
+  if (nv <= 4 && (x1 >> 3) - (x0 >> 3) <= 1 && (y1 >> 3) - (y0 >> 3) <= 1 && xmax - xmin < kSmall && ymax - ymin < kSmall &&
+      xmin > -kNear && xmax < kNear && ymin > -kNear && ymax < kNear) {
+    if (nv == 3 && x1 - x0 <= 1 && y1 - y0 <= 1) {
+      cover_tiny(p.data(), margin, x0, x1, y0, y1);
+    } else if (nv == 3) {
+      cover_small<3>(p.data(), margin, x0, x1, y0, y1);
+    } else {
+      cover_small<4>(p.data(), margin, x0, x1, y0, y1);
+    }
+    return;
+  }
+  cover_general(p.data(), nv, margin, x0, x1, y0, y1);
+}
+
+// cover() for any other polygon: edge functions in 128-bit arithmetic where they must be, the
+// triage recursion from the smallest enclosing cells (or straight to the tiles when it spans at
+// most 4 x 4 of them).
+void Pyramid::cover_general(const detail::FixedPoint* p, int nv, i64 margin, int x0, int x1, int y0, int y1) {
   Edges E;
-  E.x0 = static_cast<int>(std::max<i64>(0, ceil_div(xmin + margin - kHalfPixel, kSubpixel)));
-  E.x1 = static_cast<int>(std::min<i64>(width_ - 1, floor_div(xmax - margin - kHalfPixel, kSubpixel)));
-  E.y0 = static_cast<int>(std::max<i64>(0, ceil_div(ymin + margin - kHalfPixel, kSubpixel)));
-  E.y1 = static_cast<int>(std::min<i64>(height_ - 1, floor_div(ymax - margin - kHalfPixel, kSubpixel)));
-  if (E.x0 > E.x1 || E.y0 > E.y1) return;
+  E.x0 = x0;
+  E.x1 = x1;
+  E.y0 = y0;
+  E.y1 = y1;
   const int top = static_cast<int>(levels_.size()) - 1;
-  const int k = start_level(E.x0, E.x1, E.y0, E.y1, top);
+  const int k = start_level(x0, x1, y0, y1, top);
   const int sh = 3 * (k + 1);
-  const int cx0 = E.x0 >> sh, cx1 = E.x1 >> sh, cy0 = E.y0 >> sh, cy1 = E.y1 >> sh;
+  const int cx0 = x0 >> sh, cx1 = x1 >> sh, cy0 = y0 >> sh, cy1 = y1 >> sh;
   bool any = false;
   for (int cy = cy0; cy <= cy1 && !any; ++cy)
     for (int cx = cx0; cx <= cx1 && !any; ++cx) any = !is_full(k, cx, cy);
@@ -438,18 +646,15 @@ void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
   for (int i = 1; i + 1 < nv; ++i) area2 += detail::cross(p[0], p[i], p[i + 1]);
   if (area2 == 0) return;
   const i64 sign = area2 > 0 ? 1 : -1;
-  const i128 m2 = static_cast<i128>(margin) * margin;
   for (int i = 0; i < nv; ++i) {
     const FixedPoint q0 = p[i], q1 = p[(i + 1) % nv];
     if (q0 == q1) continue;
     // Inward normal (a, b) of the edge q0 -> q1; the edge function E(P) = (a, b) . (P - q0) is
     // |d| times the distance of P inside the edge's line.
     const i64 a = -(q1.y - q0.y) * sign, b = (q1.x - q0.x) * sign;
-    const bool owned = a > 0 || (a == 0 && b > 0);  // the fill rule (pyramid.h)
-    // Inside when E > M |d|, or E >= M |d| on an owned edge: E >= t for the integer t below.
-    const i128 nn = m2 * (static_cast<i128>(a) * a + static_cast<i128>(b) * b);
-    const i64 root = detail::isqrt_floor(nn);
-    const i64 t = owned && static_cast<i128>(root) * root == nn ? root : root + 1;
+    // Inside when E > M |d|, or E >= M |d| on an edge that owns its centres (the fill rule,
+    // pyramid.h): E >= t.
+    const i64 t = detail::inner_threshold(margin, a, b, a > 0 || (a == 0 && b > 0));
     // E(P) - t at the centre of pixel (x, y), P = 256 (x, y) + 128: 256 (a x + b y) + r.
     const i128 r = static_cast<i128>(a) * (kHalfPixel - q0.x) + static_cast<i128>(b) * (kHalfPixel - q0.y) - t;
     if (!E.add(a, b, r, width_, height_)) return;
@@ -466,7 +671,7 @@ void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
         if (!nw) continue;
         const bool was_empty = t == 0;
         t |= nw;
-        stats_.pixels_claimed += static_cast<std::uint64_t>(std::popcount(nw));
+        stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
         if (was_empty || t == kAll) propagate(0, tx, ty);
       }
     }
@@ -483,19 +688,6 @@ void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
 
 namespace {
 
-// Whether pixel (x, y) lies in corner k's cut: in the vertex's normal cone, farther than the
-// dilation from it (its nearest point of the polygon is the vertex, so it is outside the
-// rounded region). Exact.
-bool in_cut(const Corner& k, i64 dilation, int x, int y) {
-  const i64 tx = static_cast<i64>(x) * kSubpixel + kHalfPixel - k.v.x;
-  const i64 ty = static_cast<i64>(y) * kSubpixel + kHalfPixel - k.v.y;
-  if (!k.whole_plane) {
-    if (static_cast<i128>(tx) * k.px + static_cast<i128>(ty) * k.py > 0) return false;
-    if (static_cast<i128>(tx) * k.nx + static_cast<i128>(ty) * k.ny > 0) return false;
-  }
-  return static_cast<i128>(tx) * tx + static_cast<i128>(ty) * ty > static_cast<i128>(dilation) * dilation;
-}
-
 // The children of a cell (first pixel (ox, oy), children 2^sh px wide) that a pixel box
 // [x0, x1] x [y0, y1] touches.
 std::uint64_t touched(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
@@ -504,15 +696,6 @@ std::uint64_t touched(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
   const int i0 = static_cast<int>(std::max<i64>(0, (x0 - ox) >> sh)), i1 = static_cast<int>(std::min<i64>(7, (x1 - ox) >> sh));
   const int j0 = static_cast<int>(std::max<i64>(0, (y0 - oy) >> sh)), j1 = static_cast<int>(std::min<i64>(7, (y1 - oy) >> sh));
   return rect_mask(i0, i1, j0, j1);
-}
-
-// The children of that cell lying wholly inside the box.
-std::uint64_t contained(i64 ox, i64 oy, int sh, int x0, int x1, int y0, int y1) {
-  const i64 s = i64{1} << sh;
-  const i64 i0 = std::max<i64>(0, ceil_div(x0 - ox, s)), i1 = std::min<i64>(7, floor_div(x1 + 1 - ox, s) - 1);
-  const i64 j0 = std::max<i64>(0, ceil_div(y0 - oy, s)), j1 = std::min<i64>(7, floor_div(y1 + 1 - oy, s) - 1);
-  if (i0 > i1 || j0 > j1) return 0;
-  return rect_mask(static_cast<int>(i0), static_cast<int>(i1), static_cast<int>(j0), static_cast<int>(j1));
 }
 
 }  // namespace
@@ -526,23 +709,12 @@ bool Pyramid::hidden_tile(int tx, int ty, const Edges& E, const std::uint8_t* ac
   // centre is farther than the dilation; the offset polygon's mitred corners may reach there).
   const i64 ox = static_cast<i64>(tx) * 8, oy = static_cast<i64>(ty) * 8;
   const std::uint64_t cand = tile_mask(E, act, n, ox, oy, j0, j1) & ~tile(tx, ty) & touched(ox, oy, 0, E.x0, E.x1, E.y0, E.y1);
-  if (!cand) return true;
-  // Uncovered pixels of the offset polygon: visible unless a rounded corner cuts them all away.
-  std::uint64_t near_corner = 0;
-  for (int q = 0; q < E.corners; ++q) {
-    const Corner& k = E.corner[static_cast<std::size_t>(q)];
-    near_corner |= touched(ox, oy, 0, k.x0, k.x1, k.y0, k.y1);
-  }
-  if (cand & ~near_corner) return false;
+  if (!cand || E.corners == 0) return !cand;
+  // Visible unless a rounded corner cuts every one away. The normal cones of a convex polygon's
+  // vertices are disjoint, so the first whose cone holds the pixel decides.
   for (std::uint64_t bits = cand; bits; bits &= bits - 1) {
     const int bit = std::countr_zero(bits);
-    const int x = 8 * tx + (bit & 7), y = 8 * ty + (bit >> 3);
-    bool cut = false;
-    for (int q = 0; q < E.corners && !cut; ++q) {
-      const Corner& k = E.corner[static_cast<std::size_t>(q)];
-      cut = x >= k.x0 && x <= k.x1 && y >= k.y0 && y <= k.y1 && in_cut(k, E.dilation, x, y);
-    }
-    if (!cut) return false;
+    if (!E.cut(8 * tx + (bit & 7), 8 * ty + (bit >> 3))) return false;
   }
   return true;
 }
@@ -555,7 +727,7 @@ bool Pyramid::hidden_cell(int level, int cx, int cy, const Edges& E, const std::
   int n = 0;
   const int sh = 3 * level;
   const i64 s = i64{1} << sh, ox = static_cast<i64>(cx) << (sh + 3), oy = static_cast<i64>(cy) << (sh + 3);
-  std::uint64_t inside = kAll, outside = 0;
+  std::uint64_t outside = 0;
   for (int q = 0; q < n_in; ++q) {
     const int e = act_in[q];
     const i64 a = E.a[e], b = E.b[e];
@@ -563,21 +735,15 @@ bool Pyramid::hidden_cell(int level, int cx, int cy, const Edges& E, const std::
     const i64 spread = 7 * s;
     if (v.f + v.lo + (std::min<i64>(a, 0) + std::min<i64>(b, 0)) * spread >= 0) continue;
     if (v.f + v.hi + (std::max<i64>(a, 0) + std::max<i64>(b, 0)) * spread < 0) return true;  // misses the cell
-    inside &= mask64(v.f + v.lo, s * a, s * b);
     outside |= ~mask64(v.f + v.hi, s * a, s * b);
     act[static_cast<std::size_t>(n++)] = static_cast<std::uint8_t>(e);
   }
-  // Children beyond the dilated bounding box hold no pixel of the dilated polygon. A child wholly
-  // inside the offset polygon and the box, and clear of every corner's cut box, lies wholly in
-  // it.
+  // Children beyond the dilated bounding box hold no pixel of the dilated polygon. (Section 5.2
+  // also stops at a vacant child the polygon covers wholly; here the first such child is
+  // reached through its tiles instead, a few cells further, which spares classifying children
+  // against the rounded corners.)
   outside |= ~touched(ox, oy, sh, E.x0, E.x1, E.y0, E.y1);
-  inside &= contained(ox, oy, sh, E.x0, E.x1, E.y0, E.y1);
-  for (int q = 0; q < E.corners; ++q) {
-    const Corner& k = E.corner[static_cast<std::size_t>(q)];
-    inside &= ~touched(ox, oy, sh, k.x0, k.x1, k.y0, k.y1);
-  }
   const Cell& m = cell(level, cx, cy);
-  if (inside & m.v) return false;  // a vacant child the polygon covers: visible
   for (std::uint64_t active = ~(outside | m.c); active; active &= active - 1) {
     const int bit = std::countr_zero(active);
     const int x = 8 * cx + (bit & 7), y = 8 * cy + (bit >> 3);
@@ -605,21 +771,16 @@ bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
   const int np = static_cast<int>(polygon.size());
   if (np == 0) return answer(true);
   std::array<FixedPoint, kMaxVertices> p;
-  i64 xmin = INT64_MAX, xmax = INT64_MIN, ymin = INT64_MAX, ymax = INT64_MIN;
-  for (int i = 0; i < np; ++i) {
-    if (!detail::snap(polygon[static_cast<std::size_t>(i)], p[i])) return answer(false);
-    xmin = std::min(xmin, p[i].x);
-    xmax = std::max(xmax, p[i].x);
-    ymin = std::min(ymin, p[i].y);
-    ymax = std::max(ymax, p[i].y);
-  }
+  Bounds bb;
+  if (!(np == 8 ? snap_all<8>(polygon.data(), np, p.data(), bb) : snap_all<0>(polygon.data(), np, p.data(), bb))) return answer(false);
+  const auto [xmin, xmax, ymin, ymax] = bb;
   const i64 dilation = detail::snap_distance_up(dilation_px);
   Edges E;
   E.dilation = dilation;
-  E.x0 = static_cast<int>(std::max<i64>(0, ceil_div(xmin - dilation - kHalfPixel, kSubpixel)));
-  E.x1 = static_cast<int>(std::min<i64>(width_ - 1, floor_div(xmax + dilation - kHalfPixel, kSubpixel)));
-  E.y0 = static_cast<int>(std::max<i64>(0, ceil_div(ymin - dilation - kHalfPixel, kSubpixel)));
-  E.y1 = static_cast<int>(std::min<i64>(height_ - 1, floor_div(ymax + dilation - kHalfPixel, kSubpixel)));
+  E.x0 = static_cast<int>(std::max<i64>(0, (xmin - dilation - kHalfPixel + kSubpixel - 1) >> detail::kSubpixelBits));
+  E.x1 = static_cast<int>(std::min<i64>(width_ - 1, (xmax + dilation - kHalfPixel) >> detail::kSubpixelBits));
+  E.y0 = static_cast<int>(std::max<i64>(0, (ymin - dilation - kHalfPixel + kSubpixel - 1) >> detail::kSubpixelBits));
+  E.y1 = static_cast<int>(std::min<i64>(height_ - 1, (ymax + dilation - kHalfPixel) >> detail::kSubpixelBits));
   if (E.x0 > E.x1 || E.y0 > E.y1) return answer(true);  // no pixel of the viewport is that near
   const int top = static_cast<int>(levels_.size()) - 1;
   const int k = start_level(E.x0, E.x1, E.y0, E.y1, top);
@@ -634,11 +795,10 @@ bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
   const int nh = detail::convex_hull_fixed(std::span(p.data(), static_cast<std::size_t>(np)), h);
   // The offset polygon: every edge of the (counterclockwise) hull moved out by the dilation,
   // E(P) >= -D |d|, that is E(P) >= -floor(D |d|) for the integer E. Two points make a strip.
-  const i128 d2 = static_cast<i128>(dilation) * dilation;
   for (int i = 0; nh >= 2 && i < nh; ++i) {
     const FixedPoint q0 = h[i], q1 = h[(i + 1) % nh];
     const i64 a = -(q1.y - q0.y), b = q1.x - q0.x;
-    const i64 t = -detail::isqrt_floor(d2 * (static_cast<i128>(a) * a + static_cast<i128>(b) * b));
+    const i64 t = -detail::scaled_length_floor(dilation, a, b);
     const i128 r = static_cast<i128>(a) * (kHalfPixel - q0.x) + static_cast<i128>(b) * (kHalfPixel - q0.y) - t;
     if (!E.add(a, b, r, width_, height_)) return answer(true);
   }
@@ -662,34 +822,6 @@ bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
     c.nx = next.x - v.x;
     c.ny = next.y - v.y;
     c.whole_plane = nh == 1;
-    c.x0 = E.x0;
-    c.x1 = E.x1;
-    c.y0 = E.y0;
-    c.y1 = E.y1;
-    if (nh < 3) continue;  // the cut of a disc or a capsule's end is bounded by the box alone
-    // The cut lies in the mitre quadrilateral v, v + D n1, v + D (n1 + n2) / (1 + n1.n2),
-    // v + D n2 (n1, n2 the unit outward normals of the edges in and out of v). Its bounds in
-    // double, widened by a pixel, are far looser than their rounding. Only their part inside
-    // the dilated bounding box matters: pixels beyond it are outside anyway.
-    const glm::dvec2 vp(static_cast<double>(v.x) / u_px, static_cast<double>(v.y) / u_px);
-    const glm::dvec2 ein(static_cast<double>(-c.px), static_cast<double>(-c.py)), eout(static_cast<double>(c.nx), static_cast<double>(c.ny));
-    const glm::dvec2 n1 = glm::dvec2(ein.y, -ein.x) / std::hypot(ein.x, ein.y);
-    const glm::dvec2 n2 = glm::dvec2(eout.y, -eout.x) / std::hypot(eout.x, eout.y);
-    const double den = 1.0 + n1.x * n2.x + n1.y * n2.y;
-    if (den < 1e-6) continue;  // a needle: keep the whole box
-    const double dd = static_cast<double>(dilation) / u_px;
-    const glm::dvec2 q[4] = {vp, vp + dd * n1, vp + dd * n2, vp + dd * (n1 + n2) / den};
-    glm::dvec2 lo = q[0], hi = q[0];
-    for (const glm::dvec2& x : q) {
-      lo = glm::min(lo, x);
-      hi = glm::max(hi, x);
-    }
-    const double slack = 1.0 + 1e-9 * (std::abs(vp.x) + std::abs(vp.y) + dd / den);
-    // Pixel x has its centre at x + 0.5.
-    c.x0 = std::max(c.x0, static_cast<int>(std::max(-1.0, std::ceil(lo.x - slack - 0.5))));
-    c.x1 = std::min(c.x1, static_cast<int>(std::min(static_cast<double>(width_), std::floor(hi.x + slack - 0.5))));
-    c.y0 = std::max(c.y0, static_cast<int>(std::max(-1.0, std::ceil(lo.y - slack - 0.5))));
-    c.y1 = std::min(c.y1, static_cast<int>(std::min(static_cast<double>(height_), std::floor(hi.y + slack - 0.5))));
   }
 
   if (k == 0) {
@@ -718,7 +850,7 @@ bool Pyramid::covered(int x, int y) const {
 
 std::uint64_t Pyramid::covered_count() const {
   std::uint64_t n = 0;
-  for (std::uint64_t t : tiles_) n += static_cast<std::uint64_t>(std::popcount(t));
+  for (std::uint64_t t : tiles_) n += static_cast<std::uint64_t>(detail::popcount64(t));
   return n - (static_cast<std::uint64_t>(tiles_.size()) * 64 - static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_));
 }
 

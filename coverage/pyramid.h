@@ -30,6 +30,10 @@
 
 namespace terravol::coverage {
 
+namespace detail {
+struct FixedPoint;
+}
+
 // Work counters since the last clear() (Greene, section 9: "cells visited" counts every pyramid
 // cell, triage cell or finest tile, whose masks a tiling or a test composited).
 struct Stats {
@@ -137,6 +141,10 @@ class Pyramid {
   void fill(int level, int cx, int cy);
   static std::uint64_t tile_mask(const Edges& edges, const std::uint8_t* act, int n, std::int64_t ox,
                                  std::int64_t oy, int j0, int j1);
+  [[gnu::noinline]] void cover_general(const detail::FixedPoint* p, int n, std::int64_t margin, int x0, int x1, int y0, int y1);
+  void cover_tiny(const detail::FixedPoint* p, std::int64_t margin, int x0, int x1, int y0, int y1);
+  template <int N>
+  void cover_small(const detail::FixedPoint* p, std::int64_t margin, int x0, int x1, int y0, int y1);
   void cover_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
   bool hidden_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
   bool hidden_tile(int tx, int ty, const Edges& edges, const std::uint8_t* act, int n, int j0, int j1);
