@@ -205,9 +205,12 @@ class TerrainBench {
             cells.push_back({glm::length(c - v.eye), j * t_.n + i});
           }
         std::sort(cells.begin(), cells.end());
+        // The leaf's triangles in draw order, stored together as a caller projecting them just
+        // before tiling would have them (in cache).
         for (const auto& c : cells) {
-          pl.tris.push_back(2 * c.second);
-          pl.tris.push_back(2 * c.second + 1);
+          for (int q = 2 * c.second; q <= 2 * c.second + 1; ++q) {
+            if (ok_[static_cast<std::size_t>(q)]) pl.tris.push_back(tris_[static_cast<std::size_t>(q)]);
+          }
         }
       }
     }
@@ -246,7 +249,7 @@ class TerrainBench {
     bool projected = false;
     std::array<glm::dvec2, 8> corners;
     std::array<int, 4> order{};
-    std::vector<int> tris;
+    std::vector<Tri> tris;
   };
 
   int build(int i0, int j0, int size) {
@@ -277,11 +280,8 @@ class TerrainBench {
       }
     }
     if (n.kids[0] < 0) {
-      for (int k : pl.tris) {
-        if (!ok_[static_cast<std::size_t>(k)]) continue;
-        ++f.tiled;
-        p.cover(tris_[static_cast<std::size_t>(k)], margin);
-      }
+      for (const Tri& t : pl.tris) p.cover(t, margin);
+      f.tiled += pl.tris.size();
       return;
     }
     for (int k : pl.order) walk(p, k, cull, margin, dilation, f);

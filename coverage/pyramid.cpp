@@ -609,7 +609,7 @@ void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
   const int y1 = static_cast<int>(std::min<i64>(height_ - 1, (ymax - margin - kHalfPixel) >> detail::kSubpixelBits));
   if (x0 > x1 || y0 > y1) return;
   constexpr i64 kSmall = i64{1} << 15, kNear = i64{1} << 24;
-  if (nv <= 4 && (x1 >> 3) - (x0 >> 3) <= 1 && (y1 >> 3) - (y0 >> 3) <= 1 && xmax - xmin < kSmall && ymax - ymin < kSmall &&
+  if (nv <= 4 && (x1 >> 3) - (x0 >> 3) < kDirectTiles && (y1 >> 3) - (y0 >> 3) < kDirectTiles && xmax - xmin < kSmall && ymax - ymin < kSmall &&
       xmin > -kNear && xmax < kNear && ymin > -kNear && ymax < kNear) {
     if (nv == 3 && x1 - x0 <= 1 && y1 - y0 <= 1) {
       cover_tiny(p.data(), margin, x0, x1, y0, y1);
