@@ -8,8 +8,13 @@
 
 #include <glm/vec2.hpp>
 
-#if defined(__SSE2__)
+// SSE2 (every x86-64) for the word-wide mask operations; a portable scalar version otherwise,
+// or when TERRAVOL_COVERAGE_SCALAR is defined (the scalar test build checks it on x86 too).
+#if defined(__SSE2__) && !defined(TERRAVOL_COVERAGE_SCALAR)
+#define TERRAVOL_COVERAGE_SIMD 1
 #include <emmintrin.h>
+#else
+#define TERRAVOL_COVERAGE_SIMD 0
 #endif
 
 #include "coverage/pyramid.h"
@@ -31,7 +36,7 @@ struct FixedPoint {
 // Nearest integer, ties to even (the default rounding mode), for |x| < 2^62: one instruction
 // where SSE2 has it (llrint is a library call without -fno-math-errno).
 inline i64 round_even(double x) {
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
   return _mm_cvtsd_si64(_mm_set_sd(x));
 #else
   return std::llrint(x);

@@ -50,10 +50,6 @@
 #include <stdexcept>
 #include <string>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "coverage/fixed.h"
 
 namespace terravol::coverage {
@@ -85,7 +81,7 @@ constexpr std::uint64_t rect_mask(int i0, int i1, int j0, int j1) {
 // i, j in [0, 8). Word-wide: one SIMD add and one sign extraction per 2 or 4 lattice points.
 // mask64: every value must fit in 63 bits (|v| + 7 |sa| + 7 |sb| < 2^62).
 std::uint64_t mask64(i64 v, i64 sa, i64 sb) {
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
   __m128i r0 = _mm_set_epi64x(v + sa, v);
   __m128i r1 = _mm_add_epi64(r0, _mm_set1_epi64x(2 * sa));
   __m128i r2 = _mm_add_epi64(r0, _mm_set1_epi64x(4 * sa));
@@ -114,7 +110,7 @@ std::uint64_t mask64(i64 v, i64 sa, i64 sb) {
 // The same on rows j0..j1 only (the others zero), for values that fit in 32 bits
 // (|v| + 7 |sa| + 7 |sb| < 2^31).
 std::uint64_t mask32(i64 v, i64 sa, i64 sb, int j0, int j1) {
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
   const auto v0 = static_cast<std::int32_t>(v + j0 * sb), a = static_cast<std::int32_t>(sa);
   __m128i lo = _mm_set_epi32(v0 + 3 * a, v0 + 2 * a, v0 + a, v0);
   __m128i hi = _mm_add_epi32(lo, _mm_set1_epi32(4 * a));
@@ -160,7 +156,7 @@ struct SmallEdge {
 // The mask of pixels inside all N edges of a tile whose first pixel is (ox, oy), on rows
 // j0..j1, for values that fit in 32 bits over the tile: one pass, the edges' values OR-ed so
 // that one sign extraction tests them all.
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
 // The edges prepared for SIMD: columns 0..3 of a row hold c + a x + b y + (0, a, 2a, 3a).
 struct SmallLanes {
   __m128i lane, four_a, step;
@@ -490,7 +486,7 @@ void Pyramid::cover_small(const detail::FixedPoint* p, i64 margin, int x0, int x
     e[2] = small_edge(p[2], p[3], sign, margin);
     e[3] = small_edge(p[3], p[0], sign, margin);
   }
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
   std::array<SmallLanes, N> lanes;
   for (int k = 0; k < N; ++k) {
     const auto a = static_cast<std::int32_t>(e[k].a);
@@ -504,7 +500,7 @@ void Pyramid::cover_small(const detail::FixedPoint* p, i64 margin, int x0, int x
       std::uint64_t& t = tile(tx, ty);
       if (t == kAll) continue;
       ++stats_.cells_visited;
-#if defined(__SSE2__)
+#if TERRAVOL_COVERAGE_SIMD
       const std::uint64_t nw = small_mask<N>(e.data(), lanes.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
 #else
       const std::uint64_t nw = small_mask<N>(e.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
