@@ -534,12 +534,15 @@ void Pyramid::cover_tiny(const detail::FixedPoint* p, i64 margin, int x0, int x1
     e[static_cast<std::size_t>(i)] = {a, b, q0.x, q0.y, static_cast<std::uint64_t>(margin * margin) * static_cast<std::uint64_t>(a * a + b * b),
                                       a > 0 || (a == 0 && b > 0)};
   }
+  int last_tile = -1;
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       std::uint64_t& t = tile(x >> 3, y >> 3);
       const std::uint64_t bit = std::uint64_t{1} << (8 * (y & 7) + (x & 7));
       if (t & bit) continue;
-      ++stats_.cells_visited;
+      const int tile_id = (y >> 3) * levels_[0].w + (x >> 3);
+      stats_.cells_visited += tile_id != last_tile ? 1 : 0;  // tiles, as the other paths count
+      last_tile = tile_id;
       const i64 px = static_cast<i64>(x) * kSubpixel + kHalfPixel, py = static_cast<i64>(y) * kSubpixel + kHalfPixel;
       bool inside = true;
       for (const Edge& k : e) {
