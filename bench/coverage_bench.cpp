@@ -338,6 +338,17 @@ int main(int argc, char** argv) {
   }
   std::printf("{\n  \"viewport\": [%d, %d], \"repeat\": %d, \"margin_px\": %g, \"dilation_px\": %g, \"min_area_px\": %g,\n", kW, kH,
               repeat, margin, dilation, min_area);
+  {
+    Pyramid p(kW, kH);
+    std::vector<double> c;
+    for (int r = 0; r < 20 * repeat; ++r) {
+      p.cover(std::array{glm::dvec2(-10, -10), glm::dvec2(3000, -10), glm::dvec2(-10, 3000)}, 0.0);
+      const auto t = Clock::now();
+      p.clear();
+      c.push_back(ns_since(t));
+    }
+    std::printf("  \"clear_us\": %.2f,\n", median(c) * 1e-3);
+  }
   std::printf("  \"random_triangles\": [\n");
   const double areas[] = {1, 10, 100, 1e4};
   for (std::size_t i = 0; i < 4; ++i) {

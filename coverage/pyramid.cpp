@@ -301,6 +301,16 @@ Pyramid::Pyramid(int width, int height) : width_(width), height_(height) {
   clear();
 }
 
+// Whether the element (x, y) of a level (tiles at level 0) is wholly covered and whether it
+// is wholly vacant; an element beyond the grid counts as covered.
+std::pair<bool, bool> Pyramid::state(int level, int x, int y) const {
+  const Level& l = levels_[static_cast<std::size_t>(level)];
+  if (x >= l.w || y >= l.h) return {true, false};
+  if (level == 0) return {tile(x, y) == kAll, tile(x, y) == 0};
+  const Cell& m = l.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(l.w) + static_cast<std::size_t>(x)];
+  return {m.c == kAll, m.v == kAll};
+}
+
 void Pyramid::clear() {
   std::fill(tiles_.begin(), tiles_.end(), 0);
   const int tw = levels_[0].w, th = levels_[0].h;
@@ -312,33 +322,27 @@ void Pyramid::clear() {
   if (height_ % 8) {
     for (int tx = 0; tx < tw; ++tx) tile(tx, th - 1) |= row_mask(height_ % 8, 7);
   }
-  // Triage masks from the level below; missing children (beyond the grid) are covered.
-  for (std::size_t k = 1; k < levels_.size(); ++k) {
-    const Level& below = levels_[k - 1];
-    for (int cy = 0; cy < levels_[k].h; ++cy) {
-      for (int cx = 0; cx < levels_[k].w; ++cx) {
-        Cell m{0, 0};
-        for (int j = 0; j < 8; ++j) {
-          for (int i = 0; i < 8; ++i) {
-            const int x = 8 * cx + i, y = 8 * cy + j;
-            const std::uint64_t bit = std::uint64_t{1} << (8 * j + i);
-            bool f = true, e = false;
-            if (x < below.w && y < below.h) {
-              if (k == 1) {
-                f = tile(x, y) == kAll;
-                e = tile(x, y) == 0;
-              } else {
-                const Cell& ch = cell(static_cast<int>(k) - 1, x, y);
-                f = ch.c == kAll;
-                e = ch.v == kAll;
-              }
-            }
-            if (f) m.c |= bit;
-            if (e) m.v |= bit;
+  // The triage masks of an empty pyramid, computed once from the levels below.
+  if (cleared_.empty()) {
+    for (std::size_t k = 1; k < levels_.size(); ++k) {
+      for (int cy = 0; cy < levels_[k].h; ++cy) {
+        for (int cx = 0; cx < levels_[k].w; ++cx) {
+          Cell m{0, 0};
+          for (int bit = 0; bit < 64; ++bit) {
+            const auto [full, empty] = state(static_cast<int>(k) - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+            m.c |= static_cast<std::uint64_t>(full) << bit;
+            m.v |= static_cast<std::uint64_t>(empty) << bit;
           }
+          cell(static_cast<int>(k), cx, cy) = m;
         }
-        cell(static_cast<int>(k), cx, cy) = m;
       }
+      cleared_.insert(cleared_.end(), levels_[k].cells.begin(), levels_[k].cells.end());
+    }
+  } else {
+    auto from = cleared_.begin();
+    for (std::size_t k = 1; k < levels_.size(); ++k) {
+      std::copy_n(from, levels_[k].cells.size(), levels_[k].cells.begin());
+      from += static_cast<std::ptrdiff_t>(levels_[k].cells.size());
     }
   }
   stats_ = Stats{};
@@ -351,14 +355,7 @@ bool Pyramid::is_full(int level, int cx, int cy) {
 // After the element (cx, cy) of a level changed, brings its ancestors' bits up to date, up to
 // the first ancestor whose own state (wholly covered, wholly vacant) did not change.
 void Pyramid::propagate(int level, int cx, int cy) {
-  bool full, empty;
-  if (level == 0) {
-    full = tile(cx, cy) == kAll;
-    empty = tile(cx, cy) == 0;
-  } else {
-    full = cell(level, cx, cy).c == kAll;
-    empty = cell(level, cx, cy).v == kAll;
-  }
+  auto [full, empty] = state(level, cx, cy);
   for (int k = level + 1; k < static_cast<int>(levels_.size()); ++k) {
     Cell& p = cell(k, cx >> 3, cy >> 3);
     const std::uint64_t bit = std::uint64_t{1} << (8 * (cy & 7) + (cx & 7));
@@ -868,23 +865,12 @@ std::string Pyramid::check_invariants() const {
   }
   for (std::size_t k = 1; k < levels_.size(); ++k) {
     const Level& l = levels_[k];
-    const Level& below = levels_[k - 1];
     for (int cy = 0; cy < l.h; ++cy) {
       for (int cx = 0; cx < l.w; ++cx) {
         const Cell& m = l.cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(l.w) + static_cast<std::size_t>(cx)];
         for (int bit = 0; bit < 64; ++bit) {
           const int x = 8 * cx + (bit & 7), y = 8 * cy + (bit >> 3);
-          bool full = true, empty = false;
-          if (x < below.w && y < below.h) {
-            if (k == 1) {
-              full = tile(x, y) == kAll;
-              empty = tile(x, y) == 0;
-            } else {
-              const Cell& ch = below.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(below.w) + static_cast<std::size_t>(x)];
-              full = ch.c == kAll;
-              empty = ch.v == kAll;
-            }
-          }
+          const auto [full, empty] = state(static_cast<int>(k) - 1, x, y);
           const bool c = (m.c >> bit) & 1, v = (m.v >> bit) & 1;
           if (c != full || v != empty) {
             return "level " + std::to_string(k) + " cell (" + std::to_string(cx) + ", " + std::to_string(cy) +

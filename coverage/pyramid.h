@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -137,6 +138,7 @@ class Pyramid {
     return tiles_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(levels_[0].w) + static_cast<std::size_t>(tx)];
   }
   bool is_full(int level, int cx, int cy);
+  std::pair<bool, bool> state(int level, int x, int y) const;
   void propagate(int level, int cx, int cy);
   void fill(int level, int cx, int cy);
   static std::uint64_t tile_mask(const Edges& edges, const std::uint8_t* act, int n, std::int64_t ox,
@@ -152,6 +154,7 @@ class Pyramid {
   int width_, height_;
   std::vector<std::uint64_t> tiles_;  // the finest level: bit (y % 8) * 8 + (x % 8) of tile (x / 8, y / 8)
   std::vector<Level> levels_;         // [0] the tile grid (no cells), then the triage levels
+  std::vector<Cell> cleared_;         // every triage level's cells when empty, in order
   Stats stats_;
 };
 
