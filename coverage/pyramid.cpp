@@ -352,6 +352,24 @@ bool Pyramid::is_full(int level, int cx, int cy) {
   return level == 0 ? tile(cx, cy) == kAll : cell(level, cx, cy).c == kAll;
 }
 
+bool Pyramid::all_full(int level, int cx0, int cx1, int cy0, int cy1) {
+  for (int cy = cy0; cy <= cy1; ++cy)
+    for (int cx = cx0; cx <= cx1; ++cx)
+      if (!is_full(level, cx, cy)) return false;
+  return true;
+}
+
+// Covers the pixels of mask in tile (tx, ty) and brings the triage masks up to date.
+[[gnu::always_inline]] inline void Pyramid::claim(int tx, int ty, std::uint64_t mask) {
+  std::uint64_t& t = tile(tx, ty);
+  const std::uint64_t nw = mask & ~t;
+  if (!nw) return;
+  const bool was_empty = t == 0;
+  t |= nw;
+  stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
+  if (was_empty || t == kAll) propagate(0, tx, ty);
+}
+
 // After the element (cx, cy) of a level changed, brings its ancestors' bits up to date, up to
 // the first ancestor whose own state (wholly covered, wholly vacant) did not change.
 void Pyramid::propagate(int level, int cx, int cy) {
@@ -494,19 +512,13 @@ void Pyramid::cover_small(const detail::FixedPoint* p, i64 margin, int x0, int x
   for (int ty = ty0; ty <= ty1; ++ty) {
     const int j0 = std::max(0, y0 - 8 * ty), j1 = std::min(7, y1 - 8 * ty);
     for (int tx = tx0; tx <= tx1; ++tx) {
-      std::uint64_t& t = tile(tx, ty);
-      if (t == kAll) continue;
+      if (tile(tx, ty) == kAll) continue;
       ++stats_.cells_visited;
 #if TERRAVOL_COVERAGE_SIMD
-      const std::uint64_t nw = small_mask<N>(e.data(), lanes.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
+      claim(tx, ty, small_mask<N>(e.data(), lanes.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1));
 #else
-      const std::uint64_t nw = small_mask<N>(e.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
+      claim(tx, ty, small_mask<N>(e.data(), static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1));
 #endif
-      if (!nw) continue;
-      const bool was_empty = t == 0;
-      t |= nw;
-      stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
-      if (was_empty || t == kAll) propagate(0, tx, ty);
     }
   }
 }
@@ -547,11 +559,7 @@ void Pyramid::cover_tiny(const detail::FixedPoint* p, i64 margin, int x0, int x1
         const std::uint64_t v2 = static_cast<std::uint64_t>(v) * static_cast<std::uint64_t>(v);
         inside = inside && v >= 0 && (v2 > k.limit || (v2 == k.limit && k.owned));
       }
-      if (!inside) continue;
-      const bool was_empty = t == 0;
-      t |= bit;
-      ++stats_.pixels_claimed;
-      if (was_empty || t == kAll) propagate(0, x >> 3, y >> 3);
+      if (inside) claim(x >> 3, y >> 3, bit);
     }
   }
 }
@@ -632,10 +640,7 @@ void Pyramid::cover_general(const detail::FixedPoint* p, int nv, i64 margin, int
   const int k = start_level(x0, x1, y0, y1, top);
   const int sh = 3 * (k + 1);
   const int cx0 = x0 >> sh, cx1 = x1 >> sh, cy0 = y0 >> sh, cy1 = y1 >> sh;
-  bool any = false;
-  for (int cy = cy0; cy <= cy1 && !any; ++cy)
-    for (int cx = cx0; cx <= cx1 && !any; ++cx) any = !is_full(k, cx, cy);
-  if (!any) return;  // everything the polygon could claim is covered already
+  if (all_full(k, cx0, cx1, cy0, cy1)) return;  // everything the polygon could claim is covered already
 
   // Orientation from the sign of the area (twice the area, exactly).
   i128 area2 = 0;
@@ -660,15 +665,9 @@ void Pyramid::cover_general(const detail::FixedPoint* p, int nv, i64 margin, int
     for (int ty = cy0; ty <= cy1; ++ty) {
       const int j0 = std::max(0, E.y0 - 8 * ty), j1 = std::min(7, E.y1 - 8 * ty);
       for (int tx = cx0; tx <= cx1; ++tx) {
-        std::uint64_t& t = tile(tx, ty);
-        if (t == kAll) continue;
+        if (tile(tx, ty) == kAll) continue;
         ++stats_.cells_visited;
-        const std::uint64_t nw = tile_mask(E, E.all.data(), E.n, static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1) & ~t;
-        if (!nw) continue;
-        const bool was_empty = t == 0;
-        t |= nw;
-        stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
-        if (was_empty || t == kAll) propagate(0, tx, ty);
+        claim(tx, ty, tile_mask(E, E.all.data(), E.n, static_cast<i64>(tx) * 8, static_cast<i64>(ty) * 8, j0, j1));
       }
     }
     return;
@@ -782,10 +781,7 @@ bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
   const int k = start_level(E.x0, E.x1, E.y0, E.y1, top);
   const int sh = 3 * (k + 1);
   const int cx0 = E.x0 >> sh, cx1 = E.x1 >> sh, cy0 = E.y0 >> sh, cy1 = E.y1 >> sh;
-  bool any = false;
-  for (int cy = cy0; cy <= cy1 && !any; ++cy)
-    for (int cx = cx0; cx <= cx1 && !any; ++cx) any = !is_full(k, cx, cy);
-  if (!any) return answer(true);  // everything near the polygon is covered
+  if (all_full(k, cx0, cx1, cy0, cy1)) return answer(true);  // everything near the polygon is covered
 
   std::array<FixedPoint, kMaxVertices> h;
   const int nh = detail::convex_hull_fixed(std::span(p.data(), static_cast<std::size_t>(np)), h);

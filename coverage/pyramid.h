@@ -138,6 +138,8 @@ class Pyramid {
     return tiles_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(levels_[0].w) + static_cast<std::size_t>(tx)];
   }
   bool is_full(int level, int cx, int cy);
+  bool all_full(int level, int cx0, int cx1, int cy0, int cy1);
+  void claim(int tx, int ty, std::uint64_t mask);
   std::pair<bool, bool> state(int level, int x, int y) const;
   void propagate(int level, int cx, int cy);
   void fill(int level, int cx, int cy);
