@@ -586,17 +586,22 @@ bool snap_all(const glm::dvec2* v, int n, FixedPoint* p, Bounds& b) {
   return true;
 }
 
+// The contract's argument checks of cover() and hidden().
+void check_arguments(const char* function, const char* distance, double px, std::size_t points) {
+  if (!(px >= 0.0 && px <= kMaxMargin)) {
+    throw std::invalid_argument(std::string("coverage::Pyramid::") + function + ": " + distance + " " + std::to_string(px) +
+                                " px outside [0, " + std::to_string(kMaxMargin) + "]");
+  }
+  if (points > static_cast<std::size_t>(kMaxVertices)) {
+    throw std::invalid_argument(std::string("coverage::Pyramid::") + function + ": " + std::to_string(points) +
+                                " points, more than " + std::to_string(kMaxVertices));
+  }
+}
+
 }  // namespace
 
 void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
-  if (!(margin_px >= 0.0 && margin_px <= kMaxMargin)) {
-    throw std::invalid_argument("coverage::Pyramid::cover: margin " + std::to_string(margin_px) +
-                                " px outside [0, " + std::to_string(kMaxMargin) + "]");
-  }
-  if (polygon.size() > static_cast<std::size_t>(kMaxVertices)) {
-    throw std::invalid_argument("coverage::Pyramid::cover: " + std::to_string(polygon.size()) +
-                                " vertices, more than " + std::to_string(kMaxVertices));
-  }
+  check_arguments("cover", "margin", margin_px, polygon.size());
   ++stats_.cover_calls;
   const int nv = static_cast<int>(polygon.size());
   if (nv < 3) return;
@@ -750,14 +755,7 @@ bool Pyramid::hidden_cell(int level, int cx, int cy, const Edges& E, const std::
 }
 
 bool Pyramid::hidden(std::span<const glm::dvec2> polygon, double dilation_px) {
-  if (!(dilation_px >= 0.0 && dilation_px <= kMaxMargin)) {
-    throw std::invalid_argument("coverage::Pyramid::hidden: dilation " + std::to_string(dilation_px) +
-                                " px outside [0, " + std::to_string(kMaxMargin) + "]");
-  }
-  if (polygon.size() > static_cast<std::size_t>(kMaxVertices)) {
-    throw std::invalid_argument("coverage::Pyramid::hidden: " + std::to_string(polygon.size()) +
-                                " points, more than " + std::to_string(kMaxVertices));
-  }
+  check_arguments("hidden", "dilation", dilation_px, polygon.size());
   ++stats_.hidden_calls;
   const auto answer = [this](bool h) {
     stats_.hidden_true += h ? 1 : 0;
