@@ -52,6 +52,7 @@ inline constexpr double kMaxCoordinate = 16777216.0;  // 2^24 px: |x| and |y| of
 inline constexpr double kMaxMargin = 256.0;    // px: margin and dilation are in [0, kMaxMargin]
 inline constexpr int kMaxVertices = 64;        // vertices of one polygon
 
+// Not thread-safe (hidden() counts into the stats too): one pyramid per thread.
 class Pyramid {
  public:
   // An empty pyramid over a width x height viewport. Throws std::invalid_argument unless both
