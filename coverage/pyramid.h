@@ -18,7 +18,8 @@
 //   This is Mesa's rule for GL: gallium sets bottom_edge_rule for window-system framebuffers,
 //   whose rows run top-down, which makes it the same rule in GL coordinates for windows and
 //   FBOs alike (llvmpipe's lp_setup_tri.c: "GL (normally) ends up needing a bottom-left fill
-//   convention"). It only matters when margin is 0.
+//   convention"). It decides only centres lying exactly at the margin's distance from an
+//   edge, which in practice means margin 0.
 #pragma once
 
 #include <cstdint>

@@ -14,9 +14,9 @@ namespace terravol::coverage {
 // window coordinates of a glViewport(0, 0, width, height): x_w = (x / w + 1) * width / 2,
 // y_w = (y / w + 1) * height / 2 (pixels, origin bottom-left, as Pyramid takes them).
 // Points behind the eye: returns false, and writes nothing, when any point has w <= 0 or a
-// coordinate that is not finite. The projection of a box is the hull of its corners' only when
-// the whole box lies in front of the eye (w > 0 everywhere on it, which w > 0 at the corners
-// ensures, w being linear): a box reaching the eye plane has no such silhouette, and the caller
+// coordinate that is not finite. The projection of a box is the hull of its projected corners
+// only when the whole box lies in front of the eye (w > 0 everywhere on it, which w > 0 at the
+// corners ensures, w being linear): a box reaching the eye plane has no such silhouette, and the caller
 // treats it as visible (such boxes contain or touch the eye's neighbourhood, so they are visible
 // in practice; clipping them against the near plane would gain nothing). Points between the eye
 // and the near plane (0 < w < near) project normally; their window coordinates may be huge, and
