@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "app/sample_dem.h"
-#include "app/terrain_renderer.h"
+#include "app/output/sample_dem.h"
+#include "app/render/terrain_renderer.h"
 #include "bench/report.h"
 #include "bench/stats.h"
 #include "bench/suites.h"
@@ -49,7 +49,7 @@ std::string proc_field(const char* file, const std::string& key) {
 
 // What draws the frames: the OpenGL renderer string of an offscreen VTK window.
 std::string gl_renderer() {
-  app::require_x_display();
+  app::render::require_x_display();
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
   window->SetSize(16, 16);
@@ -166,7 +166,7 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     std::vector<std::filesystem::path> all;
     if (!std::filesystem::exists(tiles / "N48E009.hgt")) {
       c.log("writing 16 generated tiles into " + tiles.string());
-      all = app::write_sample_dem(tiles, 4, 4, true);
+      all = app::output::write_sample_dem(tiles, 4, 4, true);
     } else {
       for (int r = 0; r < 4; ++r)
         for (int col = 0; col < 4; ++col) {

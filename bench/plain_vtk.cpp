@@ -23,14 +23,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/camera.h"
-#include "app/png_output.h"
+#include "app/render/terrain_renderer.h"
+#include "app/render/vtk_camera.h"
 
 namespace terravol::bench {
 
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be three packed floats");
 static_assert(sizeof(glm::dvec3) == 3 * sizeof(double), "glm::dvec3 must be three packed doubles");
-static_assert(sizeof(glm::u8vec4) == 4 && sizeof(app::Rgba) == 4,
+static_assert(sizeof(glm::u8vec4) == 4 && sizeof(app::scene::Rgba) == 4,
               "colours must be four packed bytes");
 
 namespace {
@@ -110,7 +110,7 @@ std::vector<std::uint32_t> lattice_triangles(int cells) {
 }
 
 PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
-                             std::span<const app::Rgba> terrain_rgba,
+                             std::span<const app::scene::Rgba> terrain_rgba,
                              std::span<const std::uint32_t> terrain_triangles,
                              std::span<const glm::dvec3> overlay_positions,
                              std::span<const glm::u8vec4> overlay_rgba,
@@ -146,7 +146,7 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
   terrain_points->SetData(xyz);
   terrain_->SetPoints(terrain_points);
   terrain_->GetPointData()->SetScalars(rgba_array(terrain_rgba.data(), terrain_rgba.size()));
-  terrain_->SetPolys(app::triangle_cells(terrain_triangles));
+  terrain_->SetPolys(app::render::triangle_cells(terrain_triangles));
   terrain_mapper_->SetInputData(terrain_);
   setup_unlit(*terrain_mapper_, *terrain_actor_);
   terrain_actor_->ForceOpaqueOn();  // the opaque pass, depth-tested, whatever the alpha says
@@ -163,7 +163,7 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
     overlay_points->SetData(dxyz);
     overlay_->SetPoints(overlay_points);
     overlay_->GetPointData()->SetScalars(rgba_array(overlay_rgba.data(), overlay_rgba.size()));
-    overlay_->SetPolys(app::triangle_cells(overlay_triangles));
+    overlay_->SetPolys(app::render::triangle_cells(overlay_triangles));
     overlay_mapper_->SetInputData(overlay_);
     setup_unlit(*overlay_mapper_, *overlay_actor_);
     overlay_actor_->ForceTranslucentOn();
@@ -182,10 +182,10 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
   renderer_->UseFXAAOff();
   renderer_->AutomaticLightCreationOff();
   renderer_->GradientBackgroundOff();
-  const app::Rgb& bg = options.background;
+  const app::scene::Rgb& bg = options.background;
   renderer_->SetBackground(bg[0] / 255.0, bg[1] / 255.0, bg[2] / 255.0);
 
-  app::require_x_display();
+  app::render::require_x_display();
   window_->SetOffScreenRendering(1);
   window_->SetMultiSamples(0);
   window_->SetAlphaBitPlanes(peel ? 1 : 0);  // depth peeling needs destination alpha
@@ -198,7 +198,7 @@ PlainVtkScene::~PlainVtkScene() {
 }
 
 void PlainVtkScene::set_camera(const mrbsp::Camera& camera, double far_plane) {
-  app::apply_camera(camera, far_plane, *renderer_->GetActiveCamera());
+  app::render::apply_camera(camera, far_plane, *renderer_->GetActiveCamera());
 }
 
 double PlainVtkScene::render() {
@@ -216,7 +216,7 @@ bool PlainVtkScene::dual_depth_peeling() {
 
 std::vector<std::uint8_t> PlainVtkScene::rgb() const {
   if (!rendered_) return {};
-  return app::window_rgb(window_.GetPointer());
+  return app::render::window_rgb(window_.GetPointer());
 }
 
 }  // namespace terravol::bench

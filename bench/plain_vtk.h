@@ -15,8 +15,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "app/terrain_colors.h"
-#include "app/terrain_renderer.h"
+#include "app/render/terrain_renderer.h"
+#include "app/scene/terrain_colors.h"
 #include "mrbsp/terrain_tree.h"
 
 class vtkActor;
@@ -49,7 +49,7 @@ enum class Translucency : std::uint8_t {
 struct PlainVtkOptions {
   int width = 1280, height = 720;  // pixels, > 0
   Translucency translucency = Translucency::kPeel4;
-  app::Rgb background{205, 222, 240};  // one colour: no gradient, no haze
+  app::scene::Rgb background{205, 222, 240};  // one colour: no gradient, no haze
 };
 
 // Index triples of the full-resolution triangles of an
@@ -74,7 +74,7 @@ class PlainVtkScene {
   // holds an index out of range, or the size is not positive; std::runtime_error without an
   // X display.
   PlainVtkScene(std::span<const glm::vec3> terrain_positions,
-                std::span<const app::Rgba> terrain_rgba,
+                std::span<const app::scene::Rgba> terrain_rgba,
                 std::span<const std::uint32_t> terrain_triangles,
                 std::span<const glm::dvec3> overlay_positions,
                 std::span<const glm::u8vec4> overlay_rgba,

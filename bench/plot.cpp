@@ -17,9 +17,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "app/png_output.h"
-#include "app/terrain_renderer.h"
-#include "app/write_file.h"
+#include "app/output/png_output.h"
+#include "app/output/write_file.h"
+#include "app/render/terrain_renderer.h"
 
 namespace terravol::bench {
 
@@ -94,7 +94,7 @@ std::array<std::uint8_t, 3> series_color(std::size_t index) {
 
 void write_chart_png(const std::filesystem::path& path, const ChartSpec& spec) {
   check_spec(spec);
-  app::require_x_display();
+  app::render::require_x_display();
 
   vtkNew<vtkContextView> view;
   vtkRenderWindow* window = view->GetRenderWindow();
@@ -146,9 +146,9 @@ void write_chart_png(const std::filesystem::path& path, const ChartSpec& spec) {
   // vtkAxis switches to log scaling during a render pass (vtkAxis.h), after the plots have cached
   // their points in linear coordinates, which then fall outside the chart: draw again.
   if (spec.log_x || spec.log_y) window->Render();
-  const std::vector<std::uint8_t> png = app::window_png(window);
+  const std::vector<std::uint8_t> png = app::output::window_png(window);
   window->Finalize();
-  app::write_file_atomically(path, png, /*overwrite=*/true);
+  app::output::write_file_atomically(path, png, /*overwrite=*/true);
 }
 
 }  // namespace terravol::bench

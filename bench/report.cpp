@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "app/write_file.h"
+#include "app/output/write_file.h"
 #include "bench/plot.h"
 
 namespace terravol::bench {
@@ -254,9 +254,9 @@ void write_report(const json& results, const std::filesystem::path& dir) {
   scaling_section(md, results, dir);
   build_section(md, results);
   const std::string text = md.str();
-  app::write_file_atomically(dir / "report.md", std::vector<std::uint8_t>(text.begin(), text.end()), true);
+  app::output::write_file_atomically(dir / "report.md", std::vector<std::uint8_t>(text.begin(), text.end()), true);
   const std::string j = results.dump(1);
-  app::write_file_atomically(dir / "results.json", std::vector<std::uint8_t>(j.begin(), j.end()), true);
+  app::output::write_file_atomically(dir / "results.json", std::vector<std::uint8_t>(j.begin(), j.end()), true);
 }
 
 }  // namespace terravol::bench

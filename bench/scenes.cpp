@@ -8,10 +8,10 @@
 
 namespace terravol::bench {
 
-std::vector<View> flythrough(const app::WindowBounds& b, int count) {
+std::vector<View> flythrough(const app::scene::WindowBounds& b, int count) {
   const double clat = 0.5 * (b.south + b.north), clon = 0.5 * (b.west + b.east);
   // Within 0.4 of the half side from the centre: the window slides only within a quarter
-  // side of an edge (app/terrain_scene.h, plan_slide).
+  // side of an edge (app/scene/terrain_scene.h, plan_slide).
   const double dlat = 0.4 * 0.5 * (b.north - b.south), dlon = 0.4 * 0.5 * (b.east - b.west);
   std::vector<View> views;
   for (int k = 0; k < count; ++k) {
@@ -64,7 +64,7 @@ VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume:
       const volume::RfResult r = volume::compute_rf(mosaic, transmitters[k], grid);
       volume::write_vdb(file, {&r.path_loss}, false);
     }
-    app::VolumeSpec v;
+    app::scene::VolumeSpec v;
     v.file = file;
     for (const auto& [value, opacity] : iso[k % 3]) {
       volume::IsoSpec s;

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "app/camera.h"
-#include "app/scene_file.h"
-#include "app/terrain_scene.h"
+#include "app/scene/camera.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/terrain_scene.h"
 #include "volume/propagation.h"
 
 namespace terravol::bench {
@@ -22,7 +22,7 @@ struct Terrain {
 
 // One view of a path: a pose with its altitude above the ground.
 struct View {
-  app::CameraPose pose;  // pose.alt: metres above the ground under the camera
+  app::scene::CameraPose pose;  // pose.alt: metres above the ground under the camera
   bool overview = false;
 };
 
@@ -30,7 +30,7 @@ struct View {
 // slides): low oblique views (pitch -5 to -20 degrees, 600 to 2500 m above the ground) turning
 // through every heading, and every sixth view a high overview (8000 m, pitch -45).
 // Deterministic. Precondition: count >= 1.
-std::vector<View> flythrough(const app::WindowBounds& bounds, int count);
+std::vector<View> flythrough(const app::scene::WindowBounds& bounds, int count);
 
 // An orbit of `count` views around (lat, lon) at `range_km`, `agl` metres above the ground,
 // looking at the centre with pitch `pitch_deg`, starting from the south-west.
@@ -43,7 +43,7 @@ std::vector<View> orbit(double lat, double lon, double range_km, double agl, dou
 // first. `progress` is told when a volume is computed. Throws what compute_rf and write_vdb
 // throw.
 struct VolumeScene {
-  app::SceneSpec spec;
+  app::scene::SceneSpec spec;
   double lat = 0, lon = 0;  // the centre of the transmitters
 };
 VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters,

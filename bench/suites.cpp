@@ -6,9 +6,9 @@
 #include <map>
 #include <memory>
 
-#include "app/png_output.h"
-#include "app/scene_renderer.h"
-#include "app/volume_layer.h"
+#include "app/output/png_output.h"
+#include "app/render/scene_renderer.h"
+#include "app/scene/volume_layer.h"
 #include "bench/image_metrics.h"
 #include "bench/plain_vtk.h"
 #include "bench/stats.h"
@@ -24,8 +24,8 @@ void say(const BenchConfig& c, const std::string& line) {
   if (c.log) c.log(line);
 }
 
-app::RenderSettings plain_settings(const BenchConfig& c) {
-  app::RenderSettings s;
+app::render::RenderSettings plain_settings(const BenchConfig& c) {
+  app::render::RenderSettings s;
   s.width = c.width;
   s.height = c.height;
   s.gradient = false;  // one background colour in every pipeline, so images compare
@@ -35,11 +35,11 @@ app::RenderSettings plain_settings(const BenchConfig& c) {
 
 // The scene of a terrain with its window centred on (lat, lon) (the mosaic's centre when both
 // are NaN) at most `max_window` cells wide.
-app::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double lon = std::nan("")) {
-  app::SceneSpec spec;
+app::scene::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double lon = std::nan("")) {
+  app::scene::SceneSpec spec;
   spec.dems = t.dems;
   if (!std::isnan(lat)) {
-    app::SceneCamera cam;
+    app::scene::SceneCamera cam;
     cam.pose.lat = lat;
     cam.pose.lon = lon;
     cam.pose.alt = 1000;
@@ -50,7 +50,7 @@ app::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double 
 }
 
 // Frame time of the MRBSP: traversal, the upload of its triangle list, and the draw.
-double frame_ms(const app::FrameStats& s) { return s.traversal_ms + s.upload_ms + s.draw_ms; }
+double frame_ms(const app::render::FrameStats& s) { return s.traversal_ms + s.upload_ms + s.draw_ms; }
 
 mrbsp::TraversalOptions lod(mrbsp::LodMetric metric, double t) {
   mrbsp::TraversalOptions o;
@@ -61,7 +61,7 @@ mrbsp::TraversalOptions lod(mrbsp::LodMetric metric, double t) {
 
 // The full-resolution lattice of the scene's window drawn by plain VTK, with a translucent
 // overlay (empty: none).
-std::unique_ptr<PlainVtkScene> plain_scene(const app::SceneRenderer& scene, const volume::Mesh& overlay,
+std::unique_ptr<PlainVtkScene> plain_scene(const app::render::SceneRenderer& scene, const volume::Mesh& overlay,
                                            Translucency translucency, const BenchConfig& c) {
   const int n = scene.terrain().cells();
   const auto& positions = scene.terrain().tree().positions();
@@ -76,13 +76,13 @@ std::unique_ptr<PlainVtkScene> plain_scene(const app::SceneRenderer& scene, cons
                                          triangles, overlay.vertices, overlay.colors, overlay.triangles, o);
 }
 
-double far_plane(const app::SceneRenderer& scene) { return scene.terrain().far_plane(scene.camera().eye); }
+double far_plane(const app::render::SceneRenderer& scene) { return scene.terrain().far_plane(scene.camera().eye); }
 
 }  // namespace
 
 json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
   say(c, "terrain " + terrain.name + ": building the 1024-cell window");
-  app::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), 1024, 0, {}, false);
+  app::render::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), 1024, 0, {}, false);
   auto plain = plain_scene(scene, {}, Translucency::kPeel4, c);
   const std::vector<View> views = flythrough(scene.terrain().bounds(), c.views);
 
@@ -99,9 +99,9 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
   full.full_res = true;
 
   for (std::size_t v = 0; v < views.size(); ++v) {
-    const app::CameraPose& pose = views[v].pose;
+    const app::scene::CameraPose& pose = views[v].pose;
     // The reference image: every triangle of the window at the finest level, in tree order.
-    const app::FrameStats ref = scene.render(pose, true, 45.0, full);
+    const app::render::FrameStats ref = scene.render(pose, true, 45.0, full);
     const std::vector<std::uint8_t> reference = scene.rgb();
     full_triangles.push_back(static_cast<double>(ref.triangles));
     plain->set_camera(scene.camera(), far_plane(scene));
@@ -115,7 +115,7 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
       const mrbsp::TraversalOptions o = lod(k.metric, k.t);
       if (v == 0) scene.render(pose, true, 45.0, o);  // warm-up
       std::vector<double> tr, up, dr, fr;
-      app::FrameStats s;
+      app::render::FrameStats s;
       for (int r = 0; r < c.repeats; ++r) {
         s = scene.render(pose, true, 45.0, o);
         tr.push_back(s.traversal_ms);
@@ -177,36 +177,36 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
 
 json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters) {
   const VolumeScene vs = three_volume_scene(terrain, transmitters, c.cache, c.log);
-  app::SceneSpec spec = vs.spec;
+  app::scene::SceneSpec spec = vs.spec;
   spec.camera = terrain_spec(terrain, vs.lat, vs.lon).camera;  // the window centred on the volumes
   say(c, "translucency " + terrain.name + ": reading the volumes and merging them into the tree");
-  app::SceneRenderer scene(spec, plain_settings(c), 1024, 0, {}, false);
-  const app::MergeFigures merged = scene.merge_figures();
+  app::render::SceneRenderer scene(spec, plain_settings(c), 1024, 0, {}, false);
+  const app::scene::MergeFigures merged = scene.merge_figures();
   const mrbsp::MemoryStats memory = scene.terrain().tree().memory();
 
   // The same traversal in VTK's orders.
-  auto order = [&](app::DrawOrder o, int peels) {
-    app::RenderSettings s = plain_settings(c);
+  auto order = [&](app::scene::DrawOrder o, int peels) {
+    app::render::RenderSettings s = plain_settings(c);
     s.order = o;
     s.peels = peels;
     return scene.make_renderer(s);
   };
-  auto peel_exact = order(app::DrawOrder::kPeel, 0);
-  auto peel4 = order(app::DrawOrder::kPeel, 4);
-  auto oit = order(app::DrawOrder::kVtk, 0);
+  auto peel_exact = order(app::scene::DrawOrder::kPeel, 0);
+  auto peel4 = order(app::scene::DrawOrder::kPeel, 4);
+  auto oit = order(app::scene::DrawOrder::kVtk, 0);
 
   // What a ParaView user would draw: the full lattice and undecimated geometry.
   say(c, "translucency " + terrain.name + ": the plain VTK pipeline (undecimated geometry)");
   const io::Mosaic mosaic = io::Mosaic::open(spec.dems);
   const auto t0 = Clock::now();
-  const app::VolumeLayer raw(spec.volumes, mosaic, scene.frame(), 0);
+  const app::scene::VolumeLayer raw(spec.volumes, mosaic, scene.frame(), 0);
   const volume::Mesh raw_mesh = raw.visible_mesh();
   const double raw_geometry_ms = ms_since(t0);
   auto plain4 = plain_scene(scene, raw_mesh, Translucency::kPeel4, c);
   auto plain_exact = plain_scene(scene, raw_mesh, Translucency::kPeelExact, c);
 
   // Views around the volumes, within the central half of the window (no slides).
-  const app::WindowBounds b = scene.terrain().bounds();
+  const app::scene::WindowBounds b = scene.terrain().bounds();
   const double half_km = 0.5 * std::min((b.north - b.south) * 111.32,
                                         (b.east - b.west) * 111.32 * std::cos(vs.lat * 3.14159265358979 / 180.0));
   const double range_km = std::min(8.0, 0.4 * half_km);
@@ -216,10 +216,10 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   std::map<std::string, std::vector<double>> ms, err3, psnr_db, ratio;
   std::vector<double> triangles, merged_triangles, plain_triangles;
   for (std::size_t v = 0; v < views.size(); ++v) {
-    const app::CameraPose& pose = views[v].pose;
+    const app::scene::CameraPose& pose = views[v].pose;
     if (v == 0) scene.render(pose, true, 45.0, lod_default);  // warm-up
     std::vector<double> t_bsp;
-    app::FrameStats s;
+    app::render::FrameStats s;
     for (int r = 0; r < c.repeats; ++r) {
       s = scene.render(pose, true, 45.0, lod_default);
       t_bsp.push_back(frame_ms(s));
@@ -232,7 +232,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
     const double far = far_plane(scene);
 
     std::map<std::string, std::vector<std::uint8_t>> images;
-    auto time_order = [&](const std::string& name, app::TerrainRenderer& r) {
+    auto time_order = [&](const std::string& name, app::render::TerrainRenderer& r) {
       r.set_camera(scene.camera(), far);
       if (v == 0) {
         r.set_frame(scene.last_frame());
@@ -246,7 +246,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
         t.push_back(upload + r.render());
       }
       ms[name].push_back(median(t) + s.traversal_ms);  // the traversal is shared
-      images[name] = app::window_rgb(r.window());
+      images[name] = app::render::window_rgb(r.window());
     };
     time_order("peel_exact", *peel_exact);
     time_order("peel4", *peel4);
@@ -303,7 +303,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
 
   // 5. Responsiveness: from the change to the next finished frame, as the viewer sees it.
   say(c, "translucency " + terrain.name + ": responsiveness");
-  const app::CameraPose pose = views.front().pose;
+  const app::scene::CameraPose pose = views.front().pose;
   std::vector<double> threshold_ms, slice_ms, slice_merge_ms;
   for (int r = 0; r < std::max(3, c.repeats); ++r) {
     const auto u0 = Clock::now();
@@ -331,9 +331,9 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
     const Terrain& t = terrains[k];
     say(c, "scaling " + t.name + ": building its largest window");
     const auto t0 = Clock::now();
-    app::SceneRenderer scene(terrain_spec(t), plain_settings(c), 4096, 0, {}, false);
+    app::render::SceneRenderer scene(terrain_spec(t), plain_settings(c), 4096, 0, {}, false);
     const double build_ms = ms_since(t0);
-    const app::WindowBounds b = scene.terrain().bounds();
+    const app::scene::WindowBounds b = scene.terrain().bounds();
     View view;
     view.pose.lat = 0.5 * (b.south + b.north);
     view.pose.lon = 0.5 * (b.west + b.east);
@@ -343,7 +343,7 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
     const mrbsp::TraversalOptions one = lod(mrbsp::LodMetric::kError, 1.0);
     scene.render(view.pose, true, 45.0, one);  // warm-up
     std::vector<double> fr, tr;
-    app::FrameStats s;
+    app::render::FrameStats s;
     for (int r = 0; r < std::max(3, c.repeats); ++r) {
       s = scene.render(view.pose, true, 45.0, one);
       fr.push_back(frame_ms(s));
@@ -384,16 +384,16 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
 json build_suite(const BenchConfig& c, const Terrain& terrain) {
   say(c, "build " + terrain.name + ": build and slide of a 1024-cell window");
   const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
-  const app::WindowChoice w0 = app::choose_window(mosaic.rows(), mosaic.cols(), (mosaic.rows() - 1) / 2.0,
+  const app::scene::WindowChoice w0 = app::scene::choose_window(mosaic.rows(), mosaic.cols(), (mosaic.rows() - 1) / 2.0,
                                                   (mosaic.cols() - 1) / 2.0, 1024);
-  const int levels = app::default_levels(w0.cells);
-  app::WindowChoice w1 = w0;
+  const int levels = app::scene::default_levels(w0.cells);
+  app::scene::WindowChoice w1 = w0;
   w1.col0 += 1 << (levels - 1);  // one coarsest cell east
   if (w1.col0 + w1.cells > mosaic.cols() - 1) w1.col0 = w0.col0 - (1 << (levels - 1));
-  const io::SceneFrame frame = app::centre_frame(mosaic, w0);
-  const app::SceneWindow a = app::read_scene_window(mosaic, w0, frame);
-  const app::SceneWindow b = app::read_scene_window(mosaic, w1, frame);
-  auto view = [](const app::SceneWindow& s) { return mrbsp::TerrainWindow{s.window.cells, s.xs, s.ys, s.z}; };
+  const io::SceneFrame frame = app::scene::centre_frame(mosaic, w0);
+  const app::scene::SceneWindow a = app::scene::read_scene_window(mosaic, w0, frame);
+  const app::scene::SceneWindow b = app::scene::read_scene_window(mosaic, w1, frame);
+  auto view = [](const app::scene::SceneWindow& s) { return mrbsp::TerrainWindow{s.window.cells, s.xs, s.ys, s.z}; };
 
   std::vector<double> build, slide;
   std::unique_ptr<mrbsp::TerrainTree> tree;

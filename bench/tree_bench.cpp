@@ -13,7 +13,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "app/terrain_scene.h"
+#include "app/scene/terrain_scene.h"
 #include "io/error.h"
 #include "io/mosaic.h"
 #include "io/void_fill.h"
@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   }
   try {
     const io::Mosaic mosaic = io::Mosaic::open(dems);
-    if (levels == 0) levels = app::default_levels(n);
+    if (levels == 0) levels = app::scene::default_levels(n);
     const int step = n / (1 << (levels - 1));  // fine cells per coarsest cell: the slide step
     if (mosaic.rows() < n + 1 + step || mosaic.cols() < n + 1 + step) {
       std::fprintf(stderr, "terravol_tree_bench: mosaic of %d x %d samples is too small for a %d-cell window plus a slide\n",

@@ -64,6 +64,18 @@ inline Image decode_png(const std::vector<std::uint8_t>& bytes) {
   return image_of(reader);
 }
 
+// RGB bytes, width * height * 3, top row first (app::render::window_rgb); an empty image
+// (width 0) when the byte count does not match the size.
+inline Image image_of_rgb(const std::vector<std::uint8_t>& rgb, int width, int height) {
+  Image img;
+  if (width <= 0 || height <= 0 || rgb.size() != static_cast<std::size_t>(width) * height * 3) return img;
+  img.width = width;
+  img.height = height;
+  img.pixels.resize(static_cast<std::size_t>(width) * height);
+  for (std::size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
+  return img;
+}
+
 // Whether two colours differ by at most `tolerance` in every channel.
 inline bool same_color(const Rgb8& a, const Rgb8& b, int tolerance) {
   for (int k = 0; k < 3; ++k)

@@ -7,12 +7,12 @@
 
 #include <stdexcept>
 
-#include "app/terrain_renderer.h"
+#include "app/render/terrain_renderer.h"
 
 #define TERRAVOL_REQUIRE_DISPLAY()                                                         \
   do {                                                                                     \
     try {                                                                                  \
-      ::terravol::app::require_x_display();                                                \
+      ::terravol::app::render::require_x_display();                                                \
     } catch (const std::runtime_error& e) {                                                \
       GTEST_SKIP() << e.what();                                                            \
     }                                                                                      \

@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 void add_info_command(CLI::App& app);        // terravol info PATH... [--json]
 void add_sample_dem_command(CLI::App& app);  // terravol sample-dem -o DIR
@@ -17,4 +17,4 @@ void add_splat_command(CLI::App& app);       // terravol splat-volume --tx ... -
 void add_compare_command(CLI::App& app);     // terravol compare-volumes A.vdb B.vdb
 void add_image_diff_command(CLI::App& app);   // terravol compare-images A.png B.png
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/commands.h"
+#include "app/cli/commands.h"
 #include "volume/compare.h"
 #include "volume/readers.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -85,4 +85,4 @@ void add_compare_command(CLI::App& app) {
   cmd->callback([o] { run_compare(*o); });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

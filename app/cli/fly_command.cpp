@@ -18,17 +18,17 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/camera_path.h"
-#include "app/commands.h"
-#include "app/frame_sink.h"
-#include "app/render_options.h"
-#include "app/scene_file.h"
-#include "app/scene_renderer.h"
-#include "app/terrain_scene.h"
-#include "app/write_file.h"
+#include "app/cli/commands.h"
+#include "app/output/frame_sink.h"
+#include "app/output/write_file.h"
+#include "app/render/scene_renderer.h"
+#include "app/scene/camera_path.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/style.h"
+#include "app/scene/terrain_scene.h"
 #include "io/mosaic.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -79,7 +79,7 @@ bool inside(const io::Mosaic& m, double lat, double lon, double& row, double& co
 }
 
 // The keys around time t, for messages: "keys[2] and keys[3]" or "keys[2]".
-std::string keys_around(const std::vector<PathKey>& keys, double t) {
+std::string keys_around(const std::vector<scene::PathKey>& keys, double t) {
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (std::abs(keys[i].t - t) < 1e-9) return "keys[" + std::to_string(i) + "]";
     if (i + 1 < keys.size() && keys[i].t < t && t < keys[i + 1].t) {
@@ -91,9 +91,9 @@ std::string keys_around(const std::vector<PathKey>& keys, double t) {
 
 void run_fly(const FlyOptions& o) {
   const std::string source = o.path.string();
-  const CameraPathFile file = load_camera_path(o.path);
-  SceneSpec scene = file.scene_file.empty() ? parse_scene_json(file.scene, file.base_dir, source + ": scene")
-                                            : load_scene_file(file.scene_file);
+  const scene::CameraPathFile file = scene::load_camera_path(o.path);
+  scene::SceneSpec scene = file.scene_file.empty() ? scene::parse_scene_json(file.scene, file.base_dir, source + ": scene")
+                                            : scene::load_scene_file(file.scene_file);
   if (scene.dems.empty()) throw std::invalid_argument(source + ": scene: no \"dem\"; the flight needs terrain");
   for (const auto& d : scene.dems) {
     if (!std::filesystem::exists(d)) throw std::invalid_argument(source + ": scene: " + d.string() + ": no such file");
@@ -101,16 +101,18 @@ void run_fly(const FlyOptions& o) {
   for (const auto& v : scene.volumes) {
     if (!std::filesystem::exists(v.file)) throw std::invalid_argument(source + ": scene: " + v.file.string() + ": no such file");
   }
-  const SceneStyle& st = scene.style;
-
-  // Size, LOD and supersampling.
-  int width = 1280, height = 720;
+  // Size and LOD: --size and --threshold over the scene's "render" object over the defaults.
+  scene::SceneStyle given;
   if (!o.size.empty()) {
-    parse_size(o.size, width, height);
-  } else if (st.width) {
-    width = *st.width;
-    height = *st.height;
+    int w = 0, h = 0;
+    scene::parse_size(o.size, w, h);
+    given.width = w;
+    given.height = h;
   }
+  given.threshold = o.threshold;
+  const scene::SceneStyle style = scene::overlay(scene.style, given);
+  const scene::Style st = scene::resolve_style(style);
+  const int width = st.width, height = st.height;
   const bool video = is_video(o.output);
   if (video && (width % 2 != 0 || height % 2 != 0)) {
     throw std::invalid_argument("--size " + std::to_string(width) + "x" + std::to_string(height) +
@@ -121,10 +123,9 @@ void run_fly(const FlyOptions& o) {
     throw std::invalid_argument("--samples " + std::to_string(o.samples) + ": " + std::to_string(width * factor) + "x" +
                                 std::to_string(height * factor) + " is too large to render");
   }
-  mrbsp::TraversalOptions traversal;
-  traversal.metric = parse_metric(st.lod_metric.value_or("error"));
+  mrbsp::TraversalOptions traversal = st.traversal;
   traversal.skirts = true;
-  const double default_threshold = o.threshold.value_or(st.threshold.value_or(mrbsp::default_threshold(traversal.metric)));
+  const double default_threshold = style.threshold.value_or(mrbsp::default_threshold(traversal.metric));
   // Thresholds are in output pixels; the supersampled image has factor times as many per side.
   const double threshold_scale = traversal.metric == mrbsp::LodMetric::kError ? factor : factor * factor;
   const double default_fov = scene.camera ? scene.camera->fov_y_deg : 45.0;
@@ -149,7 +150,7 @@ void run_fly(const FlyOptions& o) {
     if (!parent.empty() && !std::filesystem::is_directory(parent)) {
       throw std::runtime_error(o.output.string() + ": no folder " + parent.string());
     }
-    if (!find_program("ffmpeg")) {
+    if (!output::find_program("ffmpeg")) {
       throw std::runtime_error("ffmpeg not found on PATH (needed for " + o.output.string() + "; use -o FOLDER/ for PNG frames)");
     }
   } else {
@@ -169,11 +170,11 @@ void run_fly(const FlyOptions& o) {
   const long first = static_cast<long>(std::ceil((start - t0) * o.fps - 1e-6));
   const long last = static_cast<long>(std::floor((end - t0) * o.fps + 1e-6));
   if (last < first) throw std::invalid_argument("--start/--end: no frame between them at " + fixed(o.fps, 3) + " fps");
-  const int digits = frame_digits(static_cast<long>(std::floor((t1 - t0) * o.fps + 1e-6)));
+  const int digits = output::frame_digits(static_cast<long>(std::floor((t1 - t0) * o.fps + 1e-6)));
 
   long from = first;
   if (!video && std::filesystem::is_directory(o.output)) {
-    const long present = existing_frames(o.output, first, last, digits);
+    const long present = output::existing_frames(o.output, first, last, digits);
     const auto manifest_path = o.output / kManifest;
     if (o.resume) {
       if (!std::filesystem::exists(manifest_path)) {
@@ -197,7 +198,7 @@ void run_fly(const FlyOptions& o) {
           }
         }
       }
-      const auto missing = first_missing_frame(o.output, first, last, digits);
+      const auto missing = output::first_missing_frame(o.output, first, last, digits);
       if (!missing) {
         std::printf("%s: all %ld frames present; nothing to do\n", o.output.string().c_str(), last - first + 1);
         return;
@@ -210,28 +211,24 @@ void run_fly(const FlyOptions& o) {
   }
 
   // The scene: its first window around the path's first key.
-  const PathKey& k0 = file.keys.front();
-  scene.camera = SceneCamera{CameraPose{k0.lat, k0.lon, k0.alt, 0.0, 0.0}, k0.agl, default_fov};
+  const scene::PathKey& k0 = file.keys.front();
+  scene.camera = scene::SceneCamera{scene::CameraPose{k0.lat, k0.lon, k0.alt, 0.0, 0.0}, k0.agl, default_fov};
   const io::Mosaic mosaic = io::Mosaic::open(scene.dems);
   double row = 0, col = 0;
   if (!inside(mosaic, k0.lat, k0.lon, row, col)) {
     throw std::invalid_argument(source + ": keys[0]: " + fixed(k0.lat, 5) + ", " + fixed(k0.lon, 5) + " is outside the DEM");
   }
-  RenderSettings settings;
+  render::RenderSettings settings;
   settings.width = width * factor;
   settings.height = height * factor;
-  settings.order = parse_order(st.order.value_or("bsp"));
+  settings.order = st.order;
   settings.gradient = true;
-  settings.haze_color = kHorizon;
-  settings.haze_distance = st.haze_km.value_or(60.0) * 1000.0;
+  settings.haze_color = scene::kHorizon;
+  settings.haze_distance = st.haze_km * 1000.0;
   settings.offscreen = true;
-  ShadingOptions shading;
-  if (st.sun_azimuth) shading.sun_azimuth_deg = *st.sun_azimuth;
-  if (st.sun_elevation) shading.sun_elevation_deg = *st.sun_elevation;
-  shading.tint = parse_tint(st.tint.value_or("atlas"));
-  SceneRenderer renderer(scene, settings, st.window.value_or(1024), 0, shading, st.legend.value_or(true));
+  render::SceneRenderer renderer(scene, settings, st.window, 0, st.shading, st.legend, st.surface_triangles);
 
-  const CameraPath path(file.keys, renderer.frame(),
+  const scene::CameraPath path(file.keys, renderer.frame(),
                         [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); }, file.speed,
                         default_fov, default_threshold);
   const auto time_of = [&](long k) { return t0 + static_cast<double>(k) / o.fps; };
@@ -239,7 +236,7 @@ void run_fly(const FlyOptions& o) {
   // Every frame's camera, checked before the first is drawn.
   for (long k = first; k <= last; ++k) {
     const double t = time_of(k);
-    const PathSample s = path.at(t);
+    const scene::PathSample s = path.at(t);
     const std::string when = source + ": at t=" + fixed(t, 2) + " s (frame " + std::to_string(k) + ", " +
                              keys_around(file.keys, t) + ")";
     if (!inside(mosaic, s.pose.lat, s.pose.lon, row, col)) {
@@ -257,12 +254,12 @@ void run_fly(const FlyOptions& o) {
   // Frames before `from` are not drawn, but the window slides they would have made are made,
   // so that the window (and so every pixel) at `from` is that of an uninterrupted run.
   {
-    WindowChoice w = renderer.terrain().window();
+    scene::WindowChoice w = renderer.terrain().window();
     const int step = 1 << (renderer.terrain().tree().levels() - 1);
     for (long k = 0; k < from; ++k) {
-      const PathSample s = path.at(time_of(k));
+      const scene::PathSample s = path.at(time_of(k));
       inside(mosaic, s.pose.lat, s.pose.lon, row, col);
-      const WindowChoice next = plan_slide(w, mosaic.rows(), mosaic.cols(), row, col, step);
+      const scene::WindowChoice next = scene::plan_slide(w, mosaic.rows(), mosaic.cols(), row, col, step);
       if (next.row0 == w.row0 && next.col0 == w.col0) continue;
       mrbsp::TraversalOptions tr = traversal;
       tr.threshold_px = static_cast<float>(s.threshold * threshold_scale);
@@ -272,13 +269,13 @@ void run_fly(const FlyOptions& o) {
   }
 
   // Outputs.
-  std::unique_ptr<FrameSink> sink;
+  std::unique_ptr<output::FrameSink> sink;
   if (video) {
-    sink = std::make_unique<VideoSink>(o.output, width, height, o.fps, o.crf, o.force);
+    sink = std::make_unique<output::VideoSink>(o.output, width, height, o.fps, o.crf, o.force);
   } else {
-    sink = std::make_unique<PngSequenceSink>(o.output, width, height, digits);
+    sink = std::make_unique<output::PngSequenceSink>(o.output, width, height, digits);
     const std::string text = manifest.dump(2) + "\n";
-    write_file_atomically(o.output / kManifest, std::vector<std::uint8_t>(text.begin(), text.end()), true);
+    output::write_file_atomically(o.output / kManifest, std::vector<std::uint8_t>(text.begin(), text.end()), true);
   }
   std::filesystem::path stats_tmp;
   std::ofstream stats;
@@ -301,7 +298,7 @@ void run_fly(const FlyOptions& o) {
   g_stop = 0;
   std::signal(SIGINT, on_stop_signal);
   std::signal(SIGTERM, on_stop_signal);
-  Progress progress(stderr, last - first + 1, from - first);
+  output::Progress progress(stderr, last - first + 1, from - first);
   for (long k = from; k <= last; ++k) {
     if (g_stop != 0) {
       progress.finish();
@@ -310,12 +307,12 @@ void run_fly(const FlyOptions& o) {
                                       : "; run again with --resume to continue"));
     }
     const double t = time_of(k);
-    const PathSample s = path.at(t);
+    const scene::PathSample s = path.at(t);
     mrbsp::TraversalOptions tr = traversal;
     tr.threshold_px = static_cast<float>(s.threshold * threshold_scale);
-    const FrameStats f = renderer.render(s.pose, path.agl(), s.fov_y_deg, tr);
+    const render::FrameStats f = renderer.render(s.pose, path.agl(), s.fov_y_deg, tr);
     const std::vector<std::uint8_t> rgb = renderer.rgb();
-    sink->write(k, factor == 1 ? rgb : downsample_box(rgb, width, height, factor));
+    sink->write(k, factor == 1 ? rgb : output::downsample_box(rgb, width, height, factor));
     if (stats.is_open()) {
       char b[512];
       std::snprintf(b, sizeof b, "%ld,%.4f,%.7f,%.7f,%.2f,%d,%.3f,%.3f,%.3f,%.3f,%.2f,%.2f,%zu,%zu,%zu,%.3f,%.3f,%.3f,%d,%.1f\n",
@@ -383,10 +380,10 @@ void add_fly_command(CLI::App& app) {
     if (end->count() > 0) o->end = raw->end;
     if (!o->size.empty()) {
       int w = 0, h = 0;
-      parse_size(o->size, w, h);
+      scene::parse_size(o->size, w, h);
     }
     run_fly(*o);
   });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

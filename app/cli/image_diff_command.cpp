@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/commands.h"
+#include "app/cli/commands.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -84,4 +84,4 @@ void add_image_diff_command(CLI::App& app) {
   });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "app/commands.h"
+#include "app/cli/commands.h"
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "io/geographic.h"
 #include "io/mosaic.h"
 #include "io/void_fill.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -225,4 +225,4 @@ void add_info_command(CLI::App& app) {
   });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "app/commands.h"
+#include "app/cli/commands.h"
 #include "bench/bench_command.h"
 #include "io/error.h"
 
@@ -14,15 +14,15 @@ int main(int argc, char** argv) {
       "propagation volumes, drawn through a Multiresolution BSP tree."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "terravol 0.1");
-  terravol::app::add_info_command(app);
-  terravol::app::add_sample_dem_command(app);
-  terravol::app::add_render_command(app);
-  terravol::app::add_view_command(app);
-  terravol::app::add_rf_command(app);
-  terravol::app::add_fly_command(app);
-  terravol::app::add_splat_command(app);
-  terravol::app::add_compare_command(app);
-  terravol::app::add_image_diff_command(app);
+  terravol::app::cli::add_info_command(app);
+  terravol::app::cli::add_sample_dem_command(app);
+  terravol::app::cli::add_render_command(app);
+  terravol::app::cli::add_view_command(app);
+  terravol::app::cli::add_rf_command(app);
+  terravol::app::cli::add_fly_command(app);
+  terravol::app::cli::add_splat_command(app);
+  terravol::app::cli::add_compare_command(app);
+  terravol::app::cli::add_image_diff_command(app);
   terravol::bench::add_bench_command(app);
   try {
     app.parse(argc, argv);

@@ -1,11 +1,11 @@
 // Parsing of the options `terravol rf` and `terravol splat-volume` share (rf_args.h).
-#include "app/rf_args.h"
+#include "app/cli/rf_args.h"
 
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -91,4 +91,4 @@ std::vector<double> parse_heights(const std::string& text) {
   return h;
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -7,7 +7,7 @@
 
 #include "volume/propagation.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 // "--tx LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]]": degrees (latitude within [-85, 85], longitude
 // within [-180, 180]), metres above ground within [0, 100000], MHz within (0, 100000] (900
@@ -19,4 +19,4 @@ volume::Transmitter parse_tx(const std::string& text);
 // Throws "--heights TEXT: what is wrong".
 std::vector<double> parse_heights(const std::string& text);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

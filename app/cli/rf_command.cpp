@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "app/commands.h"
-#include "app/rf_args.h"
+#include "app/cli/commands.h"
+#include "app/cli/rf_args.h"
 #include "io/mosaic.h"
 #include "volume/propagation.h"
 #include "volume/vdb_write.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -139,4 +139,4 @@ void add_rf_command(CLI::App& app) {
   cmd->callback([o] { run_rf(*o); });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include "app/commands.h"
-#include "app/rf_args.h"
-#include "app/write_file.h"
+#include "app/cli/commands.h"
+#include "app/cli/rf_args.h"
+#include "app/output/write_file.h"
 #include "volume/splat.h"
 #include "volume/vdb_write.h"
 
-namespace terravol::app {
+namespace terravol::app::cli {
 
 namespace {
 
@@ -189,7 +189,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     maps = std::move(r.maps);
     for (std::size_t n = 0; n < r.ano_texts.size(); ++n) {
       const std::string& text = r.ano_texts[n];
-      write_file_atomically(ano_name(o.ano_dir, heights[n]),
+      output::write_file_atomically(ano_name(o.ano_dir, heights[n]),
                             std::vector<std::uint8_t>(text.begin(), text.end()), o.force);
     }
   }
@@ -286,4 +286,4 @@ void add_splat_command(CLI::App& app) {
   cmd->callback([o] { run_splat_volume(*o); });
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::cli

@@ -1,4 +1,4 @@
-#include "app/frame_sink.h"
+#include "app/output/frame_sink.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -17,11 +17,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/png_output.h"
+#include "app/output/png_output.h"
 
 extern char** environ;
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 namespace {
 
@@ -300,4 +300,4 @@ void Progress::finish() {
   std::fflush(out_);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 // Takes frames in order; finish() completes the output. A sink destroyed without finish()
 // removes what is incomplete (the video's temporary file; PNG frames already written stay,
@@ -107,4 +107,4 @@ class Progress {
   long done_ = 0;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

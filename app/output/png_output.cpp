@@ -1,4 +1,4 @@
-#include "app/png_output.h"
+#include "app/output/png_output.h"
 
 #include <vtkImageData.h>
 #include <vtkNew.h>
@@ -9,9 +9,10 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "app/write_file.h"
+#include "app/output/write_file.h"
+#include "app/render/terrain_renderer.h"
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height) {
   const std::size_t row = static_cast<std::size_t>(width) * 3;
@@ -36,28 +37,13 @@ std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int widt
   return std::vector<std::uint8_t>(p, p + bytes->GetNumberOfValues());
 }
 
-std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window) {
-  int* size = window->GetSize();
-  const int w = size[0], h = size[1];
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
-  if (out.empty()) return out;
-  // The back buffer, bottom row first (OpenGL's order), turned top row first.
-  unsigned char* pixels = window->GetPixelData(0, 0, w - 1, h - 1, 0, 0);
-  const std::size_t row = static_cast<std::size_t>(w) * 3;
-  for (int y = 0; y < h; ++y) {
-    std::copy_n(pixels + static_cast<std::size_t>(h - 1 - y) * row, row, out.data() + static_cast<std::size_t>(y) * row);
-  }
-  delete[] pixels;
-  return out;
-}
-
 std::vector<std::uint8_t> window_png(vtkRenderWindow* window) {
   const int* size = window->GetSize();
-  return encode_png(window_rgb(window), size[0], size[1]);
+  return encode_png(render::window_rgb(window), size[0], size[1]);
 }
 
 void write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& png, bool overwrite) {
   write_file_atomically(path, png, overwrite);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -8,24 +8,20 @@
 
 class vtkRenderWindow;
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 // RGB (width * height * 3 bytes, top row first) encoded as PNG with vtkPNGWriter, in memory:
 // the same pixels give the same bytes. Throws std::invalid_argument when the size does not
 // match and std::runtime_error when encoding fails.
 std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height);
 
-// The last frame drawn in `window` (its back buffer, RGB, not re-rendered), encoded as PNG
-// (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.
+// The last frame drawn in `window` (render::window_rgb: its back buffer, not re-rendered),
+// encoded as PNG (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.
 std::vector<std::uint8_t> window_png(vtkRenderWindow* window);
-
-// The same frame as raw RGB bytes, width * height * 3, top row first (what a video encoder
-// takes).
-std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window);
 
 // Writes PNG bytes to `path` through a temporary file in the same folder and a rename, so a
 // reader never sees half an image. Throws std::runtime_error ("PATH: exists (use --force to
 // overwrite)") when path exists and !overwrite, and on I/O errors (write_file_atomically).
 void write_png(const std::filesystem::path& path, const std::vector<std::uint8_t>& png, bool overwrite);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -1,4 +1,4 @@
-// `terravol sample-dem`: writes the project's own small DEM (data/dem/N45E006.hgt), a
+// The project's own small DEM (data/dem/N45E006.hgt, written by `terravol sample-dem`): a
 // deterministic synthetic SRTM3 tile, so the main job runs on a fresh clone without ../shared.
 // Same bytes on every run and machine: integer hashing and values rounded to whole metres.
 // `--tiles RxC` writes a seamless mosaic of R x C such tiles from N45E006 northward and
@@ -15,13 +15,12 @@
 #include <filesystem>
 #include <fstream>
 
-#include "app/commands.h"
-#include "app/sample_dem.h"
-#include "app/write_file.h"
+#include "app/output/sample_dem.h"
+#include "app/output/write_file.h"
 #include "io/grid.h"
 #include "io/srtm_write.h"
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 namespace {
 
@@ -86,21 +85,4 @@ std::vector<std::filesystem::path> write_sample_dem(const std::filesystem::path&
   return written;
 }
 
-void add_sample_dem_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "sample-dem", "Write the bundled synthetic DEM (an SRTM3 tile, N45E006.hgt) into a folder");
-  auto dir = std::make_shared<std::filesystem::path>("data/dem");
-  auto force = std::make_shared<bool>(false);
-  auto tiles = std::make_shared<std::pair<int, int>>(1, 1);
-  cmd->add_option("-o,--output-dir", *dir, "Folder to write N45E006.hgt into")->capture_default_str();
-  cmd->add_flag("--force", *force, "Overwrite an existing file");
-  cmd->add_option("--tiles", *tiles, "Write a seamless mosaic of ROWSxCOLS tiles from N45E006 north and east (at most 8x8)")
-      ->delimiter('x')
-      ->check(CLI::Range(1, 8));
-  cmd->callback([dir, force, tiles] {
-    for (const auto& path : write_sample_dem(*dir, tiles->first, tiles->second, *force))
-      std::printf("wrote %s\n", path.string().c_str());
-  });
-}
-
-}  // namespace terravol::app
+}  // namespace terravol::app::output

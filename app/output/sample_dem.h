@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 // Writes a seamless mosaic of rows x cols SRTM3 tiles into `dir` (created if needed), from
 // N45E006 (the bundled data/dem/N45E006.hgt, byte for byte) northward and eastward; neighbours
@@ -13,4 +13,4 @@ namespace terravol::app {
 // 1 <= rows, cols <= 8, and std::runtime_error when a file exists and !force.
 std::vector<std::filesystem::path> write_sample_dem(const std::filesystem::path& dir, int rows, int cols, bool force);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -1,4 +1,4 @@
-#include "app/vtp_export.h"
+#include "app/output/vtp_export.h"
 
 #include <unistd.h>
 
@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 namespace {
 
@@ -35,7 +35,7 @@ void add_field(vtkFieldData* fd, const char* name, const double* v, int n) {
   fd->AddArray(a);
 }
 
-void add_rgb(vtkFieldData* fd, const char* name, const Rgb& c) {
+void add_rgb(vtkFieldData* fd, const char* name, const scene::Rgb& c) {
   vtkNew<vtkUnsignedCharArray> a;
   a->SetName(name);
   a->SetNumberOfComponents(3);
@@ -47,7 +47,7 @@ void add_rgb(vtkFieldData* fd, const char* name, const Rgb& c) {
 }  // namespace
 
 void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, vtkCamera* camera,
-                const RenderSettings& settings, bool overwrite) {
+                const render::RenderSettings& settings, bool overwrite) {
   if (!overwrite && std::filesystem::exists(path)) {
     throw std::runtime_error(path.string() + ": exists (use --force to overwrite)");
   }
@@ -124,4 +124,4 @@ void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, vtkCamera
   std::filesystem::rename(tmp, path);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

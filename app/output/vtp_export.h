@@ -3,12 +3,12 @@
 
 #include <filesystem>
 
-#include "app/terrain_renderer.h"
+#include "app/render/terrain_renderer.h"
 
 class vtkCamera;
 class vtkPolyData;
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 // Writes the triangles of `scene` (TerrainRenderer::scene()) exactly as drawn: the same
 // triangles in draw order, with only the points they use, renumbered in order of first use.
@@ -20,6 +20,6 @@ namespace terravol::app {
 // Written through a temporary file in the same folder and a rename. Throws
 // std::runtime_error when `path` exists and !overwrite, or when writing fails.
 void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, vtkCamera* camera,
-                const RenderSettings& settings, bool overwrite);
+                const render::RenderSettings& settings, bool overwrite);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -1,4 +1,4 @@
-#include "app/write_file.h"
+#include "app/output/write_file.h"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 void write_file_atomically(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes,
                            bool overwrite) {
@@ -28,4 +28,4 @@ void write_file_atomically(const std::filesystem::path& path, const std::vector<
   std::filesystem::rename(tmp, path);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-namespace terravol::app {
+namespace terravol::app::output {
 
 // Writes bytes to PATH.tmp-PID, then renames it to path. Throws std::runtime_error
 // ("PATH: exists (use --force to overwrite)") when path exists and !overwrite, or on I/O errors;
@@ -13,4 +13,4 @@ namespace terravol::app {
 void write_file_atomically(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes,
                            bool overwrite);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::output

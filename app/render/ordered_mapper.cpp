@@ -1,4 +1,4 @@
-#include "app/ordered_mapper.h"
+#include "app/render/ordered_mapper.h"
 
 #include <vtkActor.h>
 #include <vtkCellArray.h>
@@ -13,7 +13,7 @@
 #include <vtkTypeInt32Array.h>
 #include <vtk_glew.h>
 
-namespace terravol::app {
+namespace terravol::app::render {
 
 vtkStandardNewMacro(OrderedPolyDataMapper);
 
@@ -78,4 +78,4 @@ void OrderedPolyDataMapper::RenderPieceFinish(vtkRenderer* ren, vtkActor* act) {
   vtkOpenGLPolyDataMapper::RenderPieceFinish(ren, act);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -9,7 +9,7 @@
 
 #include <array>
 
-namespace terravol::app {
+namespace terravol::app::render {
 
 // Around its draw the mapper turns the depth test off and blending on
 // (src alpha, one minus src alpha for colour; one, one minus src alpha for alpha), through
@@ -54,4 +54,4 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   vtkNew<vtkPolyData> no_triangles_;  // the input without its triangles, for VTK's other buffers
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -1,4 +1,4 @@
-#include "app/scene_renderer.h"
+#include "app/render/scene_renderer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,10 +10,9 @@
 #include <malloc.h>
 #endif
 
-#include "app/png_output.h"
-#include "app/ground_grid.h"
+#include "app/scene/ground_grid.h"
 
-namespace terravol::app {
+namespace terravol::app::render {
 
 namespace {
 
@@ -44,8 +43,8 @@ std::string degrees(double v, char positive, char negative) {
 
 }  // namespace
 
-SceneRenderer::SceneRenderer(const SceneSpec& scene, const RenderSettings& settings, int max_window, int levels,
-                             const ShadingOptions& shading, bool legend, std::size_t surface_triangles)
+SceneRenderer::SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, int max_window, int levels,
+                             const scene::ShadingOptions& shading, bool legend, std::size_t surface_triangles)
     : mosaic_(io::Mosaic::open(scene.dems)), settings_(settings), shading_(shading), legend_(legend) {
   const io::Georef& g = mosaic_.georef();
   double row = (mosaic_.rows() - 1) / 2.0, col = (mosaic_.cols() - 1) / 2.0;
@@ -55,16 +54,16 @@ SceneRenderer::SceneRenderer(const SceneSpec& scene, const RenderSettings& setti
     row = (g.y0 - scene.camera->pose.lat) / g.dy;
     col = (std::remainder(scene.camera->pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
   }
-  const WindowChoice window = choose_window(mosaic_.rows(), mosaic_.cols(), row, col, max_window);
-  levels_ = levels > 0 ? levels : default_levels(window.cells);
-  scene_ = std::make_unique<TerrainScene>(mosaic_, window, levels_);
+  const scene::WindowChoice window = scene::choose_window(mosaic_.rows(), mosaic_.cols(), row, col, max_window);
+  levels_ = levels > 0 ? levels : scene::default_levels(window.cells);
+  scene_ = std::make_unique<scene::TerrainScene>(mosaic_, window, levels_);
 
   // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
-  volumes_ = VolumeLayer(scene.volumes, mosaic_, scene_->frame(), surface_triangles);
+  volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), surface_triangles);
   volumes_.merge_into(*scene_);
-  lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
-  const TerrainShading shading_all =
-      vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
+  const scene::TerrainShading shading_all =
+      scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
   renderer_ = std::make_unique<TerrainRenderer>(scene_->tree().positions(), shading_all, settings_,
                                                 ColorTexture{scene_->cells() + 1, lattice_.rgba});
   if (legend_) renderer_->set_legend(volumes_.legend());
@@ -72,7 +71,7 @@ SceneRenderer::SceneRenderer(const SceneSpec& scene, const RenderSettings& setti
 
 SceneRenderer::~SceneRenderer() = default;
 
-void SceneRenderer::check_inside(const CameraPose& pose) const {
+void SceneRenderer::check_inside(const scene::CameraPose& pose) const {
   const io::Georef& g = mosaic_.georef();
   const double row = (g.y0 - pose.lat) / g.dy;
   const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
@@ -85,11 +84,11 @@ void SceneRenderer::check_inside(const CameraPose& pose) const {
 }
 
 void SceneRenderer::upload_vertices() {
-  const TerrainShading all = vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  const scene::TerrainShading all = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
   renderer_->replace_vertices(scene_->tree().positions(), all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
-FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_deg,
+FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double fov_y_deg,
                                  const mrbsp::TraversalOptions& traversal) {
   check_inside(pose);
   FrameStats stats;
@@ -98,7 +97,7 @@ FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_
   const double row = (g.y0 - pose.lat) / g.dy;
   const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
   const int step = 1 << (levels_ - 1);
-  const WindowChoice next = plan_slide(scene_->window(), mosaic_.rows(), mosaic_.cols(), row, col, step);
+  const scene::WindowChoice next = scene::plan_slide(scene_->window(), mosaic_.rows(), mosaic_.cols(), row, col, step);
   if (next.row0 != scene_->window().row0 || next.col0 != scene_->window().col0) {
     const auto t0 = Clock::now();
     // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
@@ -111,7 +110,7 @@ FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_
       throw;
     }
     return_freed_memory();  // the old vertices and the merge's scratch
-    lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
+    lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
     upload_vertices();
     return_freed_memory();  // the upload's shading copies
     ++slides_;
@@ -129,11 +128,11 @@ FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_
     throw std::runtime_error(b);
   }
   const RenderSettings& s = renderer_->settings();
-  camera_ = make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, s.width, s.height,
-                              near_plane_for(clearance));
+  camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, s.width, s.height,
+                              scene::near_plane_for(clearance));
   renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
   if (s.gradient) {
-    const auto sky = sky_gradient(pose.pitch_deg, fov_y_deg);
+    const auto sky = scene::sky_gradient(pose.pitch_deg, fov_y_deg);
     renderer_->set_background(sky[0], sky[1]);
   }
 
@@ -152,25 +151,24 @@ FrameStats SceneRenderer::render(const CameraPose& pose, bool agl, double fov_y_
 }
 
 std::unique_ptr<TerrainRenderer> SceneRenderer::make_renderer(const RenderSettings& settings) const {
-  const TerrainShading all = vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+  const scene::TerrainShading all = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
   return std::make_unique<TerrainRenderer>(scene_->tree().positions(), all, settings,
                                            ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
-const MergeFigures& SceneRenderer::remerge() {
+const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
   upload_vertices();
   return volumes_.figures();
 }
 
-std::vector<std::uint8_t> SceneRenderer::rgb() const { return window_rgb(renderer_->window()); }
-std::vector<std::uint8_t> SceneRenderer::png() const { return renderer_->png(); }
+std::vector<std::uint8_t> SceneRenderer::rgb() const { return renderer_->rgb(); }
 
 double SceneRenderer::ground_height(double lat, double lon) const {
-  const WindowBounds b = scene_->bounds();
+  const scene::WindowBounds b = scene_->bounds();
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
   const io::Georef& g = mosaic_.georef();
-  return GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
+  return scene::GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -11,16 +11,16 @@
 #include <string>
 #include <vector>
 
-#include "app/camera.h"
-#include "app/scene_file.h"
-#include "app/terrain_colors.h"
-#include "app/terrain_renderer.h"
-#include "app/terrain_scene.h"
-#include "app/volume_layer.h"
+#include "app/render/terrain_renderer.h"
+#include "app/scene/camera.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/terrain_colors.h"
+#include "app/scene/terrain_scene.h"
+#include "app/scene/volume_layer.h"
 #include "io/mosaic.h"
 #include "mrbsp/terrain_tree.h"
 
-namespace terravol::app {
+namespace terravol::app::render {
 
 struct FrameStats {
   std::size_t triangles = 0;         // drawn, merged ones included
@@ -39,9 +39,9 @@ class SceneRenderer {
   // geometry. settings.gradient: the sky follows each frame's pitch. Throws io::FormatError
   // for bad DEM or volume files, std::invalid_argument for bad styles (a slice outside its
   // volume, ...) and std::runtime_error without an X display.
-  SceneRenderer(const SceneSpec& scene, const RenderSettings& settings, int max_window = 1024, int levels = 0,
-                const ShadingOptions& shading = {}, bool legend = true,
-                std::size_t surface_triangles = kDefaultSurfaceTriangles);
+  SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, int max_window = 1024, int levels = 0,
+                const scene::ShadingOptions& shading = {}, bool legend = true,
+                std::size_t surface_triangles = scene::kDefaultSurfaceTriangles);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
@@ -49,19 +49,18 @@ class SceneRenderer {
   // Renders the view of `pose` (alt above the ground when agl). Slides the window first when
   // the camera is within a quarter of its side of an edge. Throws std::runtime_error when the
   // camera is outside the mosaic or not above the ground.
-  FrameStats render(const CameraPose& pose, bool agl, double fov_y_deg, const mrbsp::TraversalOptions& traversal);
+  FrameStats render(const scene::CameraPose& pose, bool agl, double fov_y_deg, const mrbsp::TraversalOptions& traversal);
 
   std::vector<std::uint8_t> rgb() const;  // the last image: width * height * 3 bytes, top row first
-  std::vector<std::uint8_t> png() const;  // the last image as PNG
 
   // Bilinear ground height (metres, DEM datum) anywhere in the mosaic, voids filled.
   double ground_height(double lat, double lon) const;
   const io::SceneFrame& frame() const { return scene_->frame(); }
-  const TerrainScene& terrain() const { return *scene_; }
+  const scene::TerrainScene& terrain() const { return *scene_; }
   TerrainRenderer& renderer() { return *renderer_; }
   const mrbsp::Camera& camera() const { return camera_; }
   const mrbsp::Frame& last_frame() const { return frame_; }
-  const MergeFigures& merge_figures() const { return volumes_.figures(); }
+  const scene::MergeFigures& merge_figures() const { return volumes_.figures(); }
   std::size_t volume_count() const { return volumes_.size(); }
 
   // Another renderer over the same tree, vertices, shading and texture, with other settings
@@ -69,30 +68,30 @@ class SceneRenderer {
   // merges: make it again after render() reports a slide or after remerge().
   std::unique_ptr<TerrainRenderer> make_renderer(const RenderSettings& settings) const;
   // The lattice's shading (per sample, row 0 south): the colours the terrain is drawn in.
-  const TerrainShading& lattice_shading() const { return lattice_; }
+  const scene::TerrainShading& lattice_shading() const { return lattice_; }
 
   // Interactive changes to the volumes (VolumeLayer::set_slice, ...), then remerge(): merges
   // every visible volume into the tree again and uploads the vertices (what terravol view
   // does after a key). Returns what the merge cost.
-  VolumeLayer& volumes() { return volumes_; }
-  const MergeFigures& remerge();
+  scene::VolumeLayer& volumes() { return volumes_; }
+  const scene::MergeFigures& remerge();
 
  private:
   void upload_vertices();
-  void check_inside(const CameraPose& pose) const;
+  void check_inside(const scene::CameraPose& pose) const;
 
   io::Mosaic mosaic_;
   RenderSettings settings_;
-  ShadingOptions shading_;
+  scene::ShadingOptions shading_;
   bool legend_ = true;
   int levels_ = 0;
-  std::unique_ptr<TerrainScene> scene_;
-  TerrainShading lattice_;
-  VolumeLayer volumes_;
+  std::unique_ptr<scene::TerrainScene> scene_;
+  scene::TerrainShading lattice_;
+  scene::VolumeLayer volumes_;
   std::unique_ptr<TerrainRenderer> renderer_;
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
   int slides_ = 0;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -1,4 +1,4 @@
-#include "app/terrain_renderer.h"
+#include "app/render/terrain_renderer.h"
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
@@ -36,19 +36,18 @@
 #include <thread>
 #include <stdexcept>
 
-#include "app/camera.h"
-#include "app/ordered_mapper.h"
-#include "app/png_output.h"
+#include "app/render/ordered_mapper.h"
+#include "app/render/vtk_camera.h"
 
 #include <X11/Xlib.h>
 
-namespace terravol::app {
+namespace terravol::app::render {
 
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be three packed floats");
 
 namespace {
 
-void set_rgb(const Rgb& c, double out[3]) {
+void set_rgb(const scene::Rgb& c, double out[3]) {
   for (int k = 0; k < 3; ++k) out[k] = c[k] / 255.0;
 }
 
@@ -56,11 +55,11 @@ void set_rgb(const Rgb& c, double out[3]) {
 // (merged polygons), the texels, and under --lod-colors the level colours (opaque) and merged
 // vertices' RGBA again. With alpha 1 everywhere blending gives the same image, and it costs
 // about 10% of the terrain's fragment work on llvmpipe. O(vertices + texels): once per upload.
-void choose_blending(vtkPolyDataMapper& mapper, std::span<const Rgba> vertex_rgba,
-                     std::span<const Rgba> texels) {
+void choose_blending(vtkPolyDataMapper& mapper, std::span<const scene::Rgba> vertex_rgba,
+                     std::span<const scene::Rgba> texels) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(&mapper);
   if (ordered == nullptr) return;
-  const auto opaque = [](const Rgba& c) { return c[3] == 255; };
+  const auto opaque = [](const scene::Rgba& c) { return c[3] == 255; };
   ordered->set_blending(!std::all_of(vertex_rgba.begin(), vertex_rgba.end(), opaque) ||
                         !std::all_of(texels.begin(), texels.end(), opaque));
 }
@@ -94,7 +93,7 @@ void require_x_display() {
   }
 }
 
-TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                  const RenderSettings& settings, const ColorTexture& texture)
     : settings_(settings), shade_(shading.shade), point_rgba_(shading.rgba) {
   const std::size_t n = positions.size();
@@ -124,7 +123,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   rgba->SetName("rgba");
   rgba->SetNumberOfComponents(4);
   rgba->SetNumberOfTuples(count);
-  std::memcpy(rgba->GetPointer(0), shading.rgba.data(), n * sizeof(Rgba));
+  std::memcpy(rgba->GetPointer(0), shading.rgba.data(), n * sizeof(scene::Rgba));
   poly_->GetPointData()->SetScalars(rgba);
   poly_->SetPolys(vtkNew<vtkCellArray>());
   if (texture.side > 0) {
@@ -142,7 +141,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     vtkNew<vtkUnsignedCharArray> texels;
     texels->SetNumberOfComponents(4);
     texels->SetNumberOfTuples(static_cast<vtkIdType>(texture.rgba.size()));
-    std::memcpy(texels->GetPointer(0), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
+    std::memcpy(texels->GetPointer(0), texture.rgba.data(), texture.rgba.size() * sizeof(scene::Rgba));
     texture_image_->SetDimensions(texture.side, texture.side, 1);
     texture_image_->GetPointData()->SetScalars(texels);
     texture_->SetInputData(texture_image_);
@@ -156,7 +155,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     texture_->SetColorModeToDirectScalars();
   }
 
-  if (settings.order == DrawOrder::kBsp) {
+  if (settings.order == scene::DrawOrder::kBsp) {
     mapper_ = vtkSmartPointer<OrderedPolyDataMapper>::New();
   } else {
     mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
@@ -177,7 +176,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     merged_poly_->SetPoints(poly_->GetPoints());
     merged_poly_->GetPointData()->SetScalars(poly_->GetPointData()->GetScalars());
     merged_poly_->SetPolys(vtkNew<vtkCellArray>());
-    if (settings.order == DrawOrder::kSort) {
+    if (settings.order == scene::DrawOrder::kSort) {
       vtkNew<vtkDepthSortPolyData> sort;
       sort->SetInputData(merged_poly_);
       sort->SetCamera(renderer_->GetActiveCamera());
@@ -199,8 +198,8 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     if (settings.wireframe) merged_actor_->GetProperty()->SetRepresentationToWireframe();
     install_shaders(*merged_actor_, false);
     renderer_->AddActor(merged_actor_);
-    renderer_->SetUseDepthPeeling(settings.order == DrawOrder::kPeel);
-    if (settings.order == DrawOrder::kSort) {
+    renderer_->SetUseDepthPeeling(settings.order == scene::DrawOrder::kPeel);
+    if (settings.order == scene::DrawOrder::kSort) {
       // VTK 9.1 draws translucent geometry with weighted blended order-independent
       // translucency when depth peeling is off, which ignores the order of the cells; the
       // plain render steps blend in the sorted order instead.
@@ -237,7 +236,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   window_->SetDisplayId(shared_display());  // not owned: VTK leaves it open
   window_->SetOffScreenRendering(settings.offscreen ? 1 : 0);
   window_->SetMultiSamples(0);
-  window_->SetAlphaBitPlanes(settings.order == DrawOrder::kPeel ? 1 : 0);  // depth peeling needs alpha
+  window_->SetAlphaBitPlanes(settings.order == scene::DrawOrder::kPeel ? 1 : 0);  // depth peeling needs alpha
   window_->SetSize(settings.width, settings.height);
   window_->AddRenderer(renderer_);
 }
@@ -297,12 +296,12 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     colors->SetName("lod_rgba");
     colors->SetNumberOfComponents(4);
     colors->SetNumberOfTuples(triangles);
-    auto* rgba = reinterpret_cast<Rgba*>(colors->GetPointer(0));
+    auto* rgba = reinterpret_cast<scene::Rgba*>(colors->GetPointer(0));
     for (vtkIdType t = 0; t < triangles; ++t) {
       const int lv = level->GetValue(t);
       const std::uint32_t* v = &(*terrain)[static_cast<std::size_t>(3 * t)];
       if (lv == mrbsp::kSkirtLevel) {
-        rgba[t] = kSkirtColor;
+        rgba[t] = scene::kSkirtColor;
         continue;
       }
       if (lv < 0) {  // merged polygons keep their own colour
@@ -310,7 +309,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
         continue;
       }
       const float s = (shade_[v[0]] + shade_[v[1]] + shade_[v[2]]) / 3.0f;
-      rgba[t] = shaded(lod_color(lv), s);
+      rgba[t] = scene::shaded(scene::lod_color(lv), s);
     }
     poly_->GetCellData()->AddArray(colors);
   }
@@ -364,7 +363,7 @@ void TerrainRenderer::apply_color_mode() {
   if (split_orders()) install_shaders(*merged_actor_, false);
 }
 
-void TerrainRenderer::set_background(const Rgb& bottom, const Rgb& top) {
+void TerrainRenderer::set_background(const scene::Rgb& bottom, const scene::Rgb& top) {
   double c[3];
   set_rgb(bottom, c);
   renderer_->SetBackground(c);
@@ -389,7 +388,7 @@ void TerrainRenderer::set_wireframe(bool on) {
   }
 }
 
-void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   const std::size_t n = positions.size();
   if (shading.rgba.size() != n || shading.normals.size() != n || shading.shade.size() != n ||
@@ -414,10 +413,10 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   copy(poly_->GetPoints()->GetData(), positions.data(), n * sizeof(glm::vec3));
   poly_->GetPoints()->Modified();
   copy(poly_->GetPointData()->GetNormals(), shading.normals.data(), n * sizeof(glm::vec3));
-  copy(poly_->GetPointData()->GetScalars(), shading.rgba.data(), n * sizeof(Rgba));
+  copy(poly_->GetPointData()->GetScalars(), shading.rgba.data(), n * sizeof(scene::Rgba));
   if (texture_side_ > 0) {
     copy(poly_->GetPointData()->GetTCoords(), shading.tcoords.data(), n * sizeof(glm::vec2));
-    copy(texture_image_->GetPointData()->GetScalars(), texture.rgba.data(), texture.rgba.size() * sizeof(Rgba));
+    copy(texture_image_->GetPointData()->GetScalars(), texture.rgba.data(), texture.rgba.size() * sizeof(scene::Rgba));
     texture_image_->Modified();
   }
   shade_ = shading.shade;
@@ -439,7 +438,7 @@ void TerrainRenderer::release_vertices() {
   }
   poly_->GetPoints()->Modified();
   std::vector<float>().swap(shade_);
-  std::vector<Rgba>().swap(point_rgba_);
+  std::vector<scene::Rgba>().swap(point_rgba_);
   // The mappers' vertex and index buffers. The next render() builds them again, as it would
   // after replace_vertices() anyway; shader programs stay in the window's cache.
   window_->MakeCurrent();
@@ -449,7 +448,7 @@ void TerrainRenderer::release_vertices() {
   if (split_orders()) merged_poly_->Modified();
 }
 
-void TerrainRenderer::set_legend(const Legend& legend) {
+void TerrainRenderer::set_legend(const scene::Legend& legend) {
   if (legend_ != nullptr) renderer_->RemoveActor2D(legend_);
   legend_ = nullptr;
   if (legend.colors.empty()) return;
@@ -457,7 +456,7 @@ void TerrainRenderer::set_legend(const Legend& legend) {
   const bool discrete = !legend.labels.empty();
   table->SetNumberOfTableValues(static_cast<vtkIdType>(legend.colors.size()));
   for (std::size_t k = 0; k < legend.colors.size(); ++k) {
-    const Rgb& c = legend.colors[k];
+    const scene::Rgb& c = legend.colors[k];
     table->SetTableValue(static_cast<vtkIdType>(k), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
   }
   if (discrete) {
@@ -497,6 +496,21 @@ double TerrainRenderer::render() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::vector<std::uint8_t> TerrainRenderer::png() const { return window_png(window_); }
+std::vector<std::uint8_t> TerrainRenderer::rgb() const { return window_rgb(window_); }
 
-}  // namespace terravol::app
+std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window) {
+  int* size = window->GetSize();
+  const int w = size[0], h = size[1];
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
+  if (out.empty()) return out;
+  // The back buffer, bottom row first (OpenGL's order), turned top row first.
+  unsigned char* pixels = window->GetPixelData(0, 0, w - 1, h - 1, 0, 0);
+  const std::size_t row = static_cast<std::size_t>(w) * 3;
+  for (int y = 0; y < h; ++y) {
+    std::copy_n(pixels + static_cast<std::size_t>(h - 1 - y) * row, row, out.data() + static_cast<std::size_t>(y) * row);
+  }
+  delete[] pixels;
+  return out;
+}
+
+}  // namespace terravol::app::render

@@ -17,7 +17,9 @@
 
 #include <glm/vec3.hpp>
 
-#include "app/terrain_colors.h"
+#include "app/scene/style.h"
+#include "app/scene/terrain_colors.h"
+#include "app/scene/volume_layer.h"
 #include "mrbsp/terrain_tree.h"
 
 class vtkActor;
@@ -31,36 +33,23 @@ class vtkRenderWindow;
 class vtkScalarBarActor;
 class vtkTexture;
 
-namespace terravol::app {
-
-enum class DrawOrder : std::uint8_t {
-  kBsp,      // the tree's back-to-front order, depth test off (OrderedPolyDataMapper)
-  kZBuffer,  // the same triangles in the same order, vtkPolyDataMapper with the depth test on
-  // The references for translucency, all with the terrain opaque and depth-tested and the
-  // merged triangles of the same frame in a second, translucent actor:
-  kPeel,  // VTK's depth peeling, occlusion ratio 0; with no limit on peels (the default): exact
-  kVtk,   // VTK 9.1's default translucent pass: weighted blended order-independent
-          // translucency (McGuire and Bavoil 2013), depth test on
-  kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
-};
-
-using Rgb = std::array<std::uint8_t, 3>;
+namespace terravol::app::render {
 
 struct RenderSettings {
   int width = 1280, height = 720;  // pixels
-  DrawOrder order = DrawOrder::kBsp;
+  scene::DrawOrder order = scene::DrawOrder::kBsp;
   int peels = 0;  // kPeel: most depth peels, 0 = no limit (exact; ParaView's default is 4)
   bool wireframe = false;
   bool lod_colors = false;              // per-triangle colours from Frame::level
-  Rgb background{205, 222, 240};        // uniform, or the bottom of the gradient
-  Rgb background_top{95, 145, 210};     // used when gradient
+  scene::Rgb background{205, 222, 240};     // uniform, or the bottom of the gradient
+  scene::Rgb background_top{95, 145, 210};  // used when gradient
   bool gradient = true;                 // a sky gradient, bottom to top
   // Aerial perspective: colours fade toward haze_color with depth d (metres along the view
   // axis) by 1 - exp(-d / haze_distance), at most 85%; 0 turns it off. Computed per vertex in
   // the vertex shader and mixed in by the fragment shader, so the vertex colours (and
   // --export-vtp) are unhazed.
   double haze_distance = 0.0;
-  Rgb haze_color{214, 226, 238};
+  scene::Rgb haze_color{214, 226, 238};
   // false: an on-screen window (terravol view), whose interactor the caller attaches.
   bool offscreen = true;
 };
@@ -70,14 +59,18 @@ struct RenderSettings {
 // geometry is drawn at (bilinear, no mipmaps), instead of being interpolated between the
 // vertices of coarse triangles. Not drawn while lod_colors is on.
 struct ColorTexture {
-  int side = 0;                // n + 1; 0: no texture, per-vertex colours
-  std::span<const Rgba> rgba;  // side * side
+  int side = 0;                       // n + 1; 0: no texture, per-vertex colours
+  std::span<const scene::Rgba> rgba;  // side * side
 };
 
 // Index triples as a vtkCellArray of triangles with 32-bit connectivity (offsets 0, 3, 6, ...),
 // the form the ordered mapper uploads as its index buffer without a copy. Precondition: every
 // index fits an int32 (VTK's 32-bit connectivity).
 vtkSmartPointer<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indices);
+
+// The last frame drawn in `window` (its back buffer, RGB, not re-rendered): width * height * 3
+// bytes, top row first (what a PNG encoder or a video encoder takes).
+std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window);
 
 // Throws std::runtime_error (one line, naming $DISPLAY and xvfb-run) when no X display can be
 // opened: VTK 9.1 on Debian renders through GLX even offscreen, and aborts without a display.
@@ -91,7 +84,7 @@ class TerrainRenderer {
   // connection (require_x_display).
   // Throws std::invalid_argument when the counts differ or the size is not positive, and
   // std::runtime_error without an X display.
-  TerrainRenderer(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+  TerrainRenderer(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                   const RenderSettings& settings, const ColorTexture& texture = {});
   ~TerrainRenderer();
   TerrainRenderer(const TerrainRenderer&) = delete;
@@ -109,7 +102,7 @@ class TerrainRenderer {
 
   // The sky gradient's colours (bottom, top), or the uniform background (bottom) when the
   // settings have no gradient.
-  void set_background(const Rgb& bottom, const Rgb& top);
+  void set_background(const scene::Rgb& bottom, const scene::Rgb& top);
 
   // Display switches for the interactive viewer; they take effect at the next set_frame() and
   // render(). LOD colours replace the texture and turn the haze off while on.
@@ -121,7 +114,7 @@ class TerrainRenderer {
   // the window). The vertex count may change (merged polygons come and go); the texture side
   // must be the constructor's, and the attribute counts must match the positions, else
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
-  void replace_vertices(const std::vector<glm::vec3>& positions, const TerrainShading& shading,
+  void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                         const ColorTexture& texture = {});
   // Frees every vertex array, the triangle lists and their buffers on the GPU (host memory
   // under Mesa's llvmpipe), keeping the texture. Call it before a slide or merge that will
@@ -133,16 +126,10 @@ class TerrainRenderer {
   // A colour legend (vtkScalarBarActor) in the lower right, or none when `legend.colors` is
   // empty. Continuous: colours sampled evenly over [lo, hi]; discrete (isosurfaces): one
   // swatch per entry of `labels`, colours[k] for labels[k].
-  struct Legend {
-    std::string title;
-    double lo = 0.0, hi = 1.0;
-    std::vector<Rgb> colors;
-    std::vector<std::string> labels;  // empty: continuous
-  };
-  void set_legend(const Legend& legend);
+  void set_legend(const scene::Legend& legend);
 
-  // The last rendered image, encoded as PNG.
-  std::vector<std::uint8_t> png() const;
+  // The last rendered image (the back buffer, not re-rendered): window_rgb(window()).
+  std::vector<std::uint8_t> rgb() const;
 
   // The scene: every point, arrays "normals", "rgba" (point data), the current triangles in draw
   // order, and with lod_colors the cell array "lod_rgba" and always "level" (cell data).
@@ -155,11 +142,11 @@ class TerrainRenderer {
  private:
   void apply_color_mode();
   void install_shaders(vtkActor& actor, bool textured);
-  bool split_orders() const { return settings_.order != DrawOrder::kBsp && settings_.order != DrawOrder::kZBuffer; }
+  bool split_orders() const { return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer; }
 
   RenderSettings settings_;
   std::vector<float> shade_;      // per vertex, for --lod-colors
-  std::vector<Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
+  std::vector<scene::Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
   int texture_side_ = 0;          // 0: no texture
   vtkNew<vtkPolyData> poly_;
   vtkNew<vtkImageData> texture_image_;
@@ -177,4 +164,4 @@ class TerrainRenderer {
   vtkNew<vtkRenderWindow> window_;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -1,6 +1,4 @@
-#include "app/camera.h"
-
-#include <vtkCamera.h>
+#include "app/scene/camera.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,7 +10,7 @@
 
 #include <glm/geometric.hpp>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -74,14 +72,4 @@ mrbsp::Camera make_scene_camera(const io::SceneFrame& frame, const CameraPose& p
   return c;
 }
 
-void apply_camera(const mrbsp::Camera& camera, double far_plane, vtkCamera& vtk_camera) {
-  const glm::dvec3 focal = camera.eye + camera.forward;
-  vtk_camera.SetPosition(camera.eye.x, camera.eye.y, camera.eye.z);
-  vtk_camera.SetFocalPoint(focal.x, focal.y, focal.z);
-  vtk_camera.SetViewUp(camera.up.x, camera.up.y, camera.up.z);
-  vtk_camera.SetViewAngle(camera.fov_y_deg);
-  vtk_camera.UseHorizontalViewAngleOff();
-  vtk_camera.SetClippingRange(camera.near_plane, far_plane);
-}
-
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,5 +1,6 @@
 // The render camera: a geodetic pose (latitude, longitude, altitude, heading, pitch) turned into
-// a pinhole camera in the scene frame (io/scene_frame.h), for the tree and for VTK alike.
+// a pinhole camera in the scene frame (io/scene_frame.h), for the tree and (render/vtk_camera.h)
+// for VTK alike.
 #pragma once
 
 #include <string_view>
@@ -7,9 +8,7 @@
 #include "io/scene_frame.h"
 #include "mrbsp/terrain_tree.h"
 
-class vtkCamera;
-
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // Where the camera is and where it looks, as the user gives it.
 struct CameraPose {
@@ -42,8 +41,4 @@ double near_plane_for(double clearance_m);
 mrbsp::Camera make_scene_camera(const io::SceneFrame& frame, const CameraPose& pose, double eye_height,
                                 double fov_y_deg, int width, int height, double near_plane);
 
-// Gives a vtkCamera the same view: position, focal point one metre ahead, view up, vertical view
-// angle, and the clipping range [camera.near_plane, far_plane].
-void apply_camera(const mrbsp::Camera& camera, double far_plane, vtkCamera& vtk_camera);
-
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -6,9 +6,9 @@
 // Orientations: Shoemake's squad (1985), with inner points chosen from a three-point tangent in
 // the quaternions' log space scaled by each segment's duration, so that the angular velocity
 // is continuous at keys spaced unevenly in time (squad itself assumes equal spacing).
-#include "app/camera_path.h"
+#include "app/scene/camera_path.h"
 
-#include "app/json_reader.h"
+#include "app/scene/json_reader.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +21,7 @@
 
 #include <glm/geometric.hpp>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -419,4 +419,4 @@ PathSample CameraPath::at(double t) const {
   return out;
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -17,10 +17,10 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
-#include "app/camera.h"
+#include "app/scene/camera.h"
 #include "io/scene_frame.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // A point the camera looks at.
 struct LookAt {
@@ -130,4 +130,4 @@ class CameraPath {
   double length_ = 0.0;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,9 +1,9 @@
-#include "app/flight.h"
+#include "app/scene/flight.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -46,4 +46,4 @@ CameraPose look(const CameraPose& pose, double dx_px, double dy_px, const Flight
   return turned(pose, dx_px * settings.look_deg_per_px, dy_px * settings.look_deg_per_px, settings);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -5,10 +5,10 @@
 
 #include <functional>
 
-#include "app/camera.h"
+#include "app/scene/camera.h"
 #include "io/scene_frame.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // What is held down at one instant; each axis is -1, 0 or +1 (both keys of an axis cancel).
 struct FlightInput {
@@ -54,4 +54,4 @@ CameraPose fly(const CameraPose& pose, const FlightInput& input, double dt, cons
 // Heading in [0, 360), pitch within +-max_pitch.
 CameraPose look(const CameraPose& pose, double dx_px, double dy_px, const FlightSettings& settings);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

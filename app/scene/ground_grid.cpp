@@ -1,11 +1,11 @@
-#include "app/ground_grid.h"
+#include "app/scene/ground_grid.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "io/void_fill.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 GroundGrid::GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east) {
   const io::Georef& g = mosaic.georef();
@@ -31,4 +31,4 @@ double GroundGrid::operator()(double lat, double lon) const {
   return (1 - fr) * ((1 - fc) * h(r0, c0) + fc * h(r0, c0 + 1)) + fr * ((1 - fc) * h(r0 + 1, c0) + fc * h(r0 + 1, c0 + 1));
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

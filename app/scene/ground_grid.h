@@ -6,7 +6,7 @@
 #include "io/grid.h"
 #include "io/mosaic.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 class GroundGrid {
  public:
@@ -25,4 +25,4 @@ class GroundGrid {
   double lat0_ = 0, lon0_ = 0, dlat_ = 1, dlon_ = 1;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // "%g" of a number, for messages.
 inline std::string format_number(double v) {
@@ -75,4 +75,4 @@ class JsonReader {
   std::string source_, noun_;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

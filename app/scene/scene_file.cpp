@@ -1,4 +1,4 @@
-#include "app/scene_file.h"
+#include "app/scene/scene_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -8,11 +8,11 @@
 #include <set>
 #include <stdexcept>
 
-#include "app/json_reader.h"
-#include "app/render_options.h"
+#include "app/scene/json_reader.h"
+#include "app/scene/style.h"
 #include "volume/colormap.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -211,4 +211,4 @@ SceneSpec load_scene_file(const std::filesystem::path& path) {
   return parse_scene_json(doc, path.parent_path(), source);
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -11,10 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "app/camera.h"
+#include "app/scene/camera.h"
+#include "app/scene/style.h"
 #include "volume/geometry.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 struct VolumeSpec {
   std::filesystem::path file;
@@ -31,22 +32,11 @@ struct SceneCamera {
   double fov_y_deg = 45.0;
 };
 
-// The "render" object: every key optional; what is absent keeps the command's default.
-struct SceneStyle {
-  std::optional<int> width, height;
-  std::optional<double> threshold;
-  std::optional<std::string> lod_metric, order, tint;
-  std::optional<int> window;
-  std::optional<double> haze_km, sun_azimuth, sun_elevation;
-  std::optional<bool> legend;
-  std::optional<std::size_t> surface_triangles;
-};
-
 struct SceneSpec {
   std::vector<std::filesystem::path> dems;
   std::vector<VolumeSpec> volumes;
   std::optional<SceneCamera> camera;
-  SceneStyle style;
+  SceneStyle style;  // the "render" object
 };
 
 // Parses a scene document. `base` resolves relative paths; `source` names the document in
@@ -58,4 +48,4 @@ SceneSpec parse_scene_json(const nlohmann::json& doc, const std::filesystem::pat
 // for a missing file, malformed JSON (with the byte offset) and whatever parse_scene_json rejects.
 SceneSpec load_scene_file(const std::filesystem::path& path);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,11 +1,14 @@
-#include "app/render_options.h"
+#include "app/scene/style.h"
 
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
-namespace terravol::app {
+#include "app/scene/scene_file.h"
+
+namespace terravol::app::scene {
 
 namespace {
 
@@ -23,7 +26,38 @@ std::string quote(std::string_view option, std::string_view text) {
   return std::string(option) + " " + std::string(text) + ": ";
 }
 
+// Every key of SceneStyle, once: what overlay() takes from each source.
+constexpr auto kStyleKeys =
+    std::make_tuple(&SceneStyle::width, &SceneStyle::height, &SceneStyle::threshold, &SceneStyle::lod_metric,
+                    &SceneStyle::order, &SceneStyle::tint, &SceneStyle::window, &SceneStyle::haze_km,
+                    &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend,
+                    &SceneStyle::surface_triangles);
+
 }  // namespace
+
+SceneStyle overlay(const SceneStyle& file, const SceneStyle& given) {
+  SceneStyle s = file;
+  std::apply([&](auto... key) { ((given.*key ? void(s.*key = given.*key) : void()), ...); }, kStyleKeys);
+  return s;
+}
+
+Style resolve_style(const SceneStyle& s) {
+  Style r;
+  if (s.width) r.width = *s.width;
+  if (s.height) r.height = *s.height;
+  if (s.lod_metric) r.traversal.metric = parse_metric(*s.lod_metric);
+  r.traversal.threshold_px = resolve_threshold(s.threshold.has_value(), s.threshold.value_or(0.0), std::nullopt,
+                                               r.traversal.metric);
+  if (s.order) r.order = parse_order(*s.order);
+  if (s.tint) r.shading.tint = parse_tint(*s.tint);
+  if (s.window) r.window = *s.window;
+  if (s.haze_km) r.haze_km = *s.haze_km;
+  if (s.sun_azimuth) r.shading.sun_azimuth_deg = *s.sun_azimuth;
+  if (s.sun_elevation) r.shading.sun_elevation_deg = *s.sun_elevation;
+  if (s.legend) r.legend = *s.legend;
+  if (s.surface_triangles) r.surface_triangles = *s.surface_triangles;
+  return r;
+}
 
 std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::string* camera_text, bool fov_given,
                                          bool& agl, double& fov_y_deg) {
@@ -42,15 +76,20 @@ float resolve_threshold(bool given, double option, const std::optional<double>& 
   return static_cast<float>(t);
 }
 
-void check_view_options(double fov_y_deg, int max_window, double haze_km, bool levels_given, int levels) {
+void check_view_options(double fov_y_deg, const Style& style, bool levels_given, int levels) {
   if (!(fov_y_deg > 0.0 && fov_y_deg < 180.0)) {
     throw std::invalid_argument("--fov " + std::to_string(fov_y_deg) + ": must be within (0, 180) degrees");
   }
-  if (max_window < 2 || (max_window & (max_window - 1)) != 0) {
-    throw std::invalid_argument("--window " + std::to_string(max_window) + ": must be a power of two >= 2");
+  const int window = style.window;
+  if (window < 2 || (window & (window - 1)) != 0) {
+    throw std::invalid_argument("--window " + std::to_string(window) + ": must be a power of two >= 2");
   }
-  if (!(haze_km >= 0.0) || !std::isfinite(haze_km)) throw std::invalid_argument("--haze: must be a distance >= 0 km");
+  if (!(style.haze_km >= 0.0) || !std::isfinite(style.haze_km)) {
+    throw std::invalid_argument("--haze: must be a distance >= 0 km");
+  }
   if (levels_given && levels < 1) throw std::invalid_argument("--levels " + std::to_string(levels) + ": must be >= 1");
+  const double sun = style.shading.sun_elevation_deg;
+  if (!(sun > 0.0 && sun <= 90.0)) throw std::invalid_argument("--sun-elevation: must be within (0, 90] degrees");
 }
 
 void parse_size(std::string_view text, int& width, int& height) {
@@ -85,6 +124,8 @@ mrbsp::LodMetric parse_metric(std::string_view text) {
   throw std::invalid_argument(quote("--lod-metric", text) + "unknown metric (expected error or area)");
 }
 
+const char* metric_name(mrbsp::LodMetric metric) { return metric == mrbsp::LodMetric::kError ? "error" : "area"; }
+
 DrawOrder parse_order(std::string_view text) {
   if (text == "bsp") return DrawOrder::kBsp;
   if (text == "zbuffer") return DrawOrder::kZBuffer;
@@ -105,59 +146,6 @@ const char* order_name(DrawOrder order) {
   return "?";
 }
 
-void add_scene_options(CLI::App& cmd, SceneArgs& args) {
-  cmd.add_option("--scene", args.scene,
-                 "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
-  cmd.add_option("--volume", args.volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
-  cmd.add_option("--field", args.field, "The --volume files' grid or array (default: the first)");
-  cmd.add_option("--volume-frame", args.volume_frame,
-                 "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
-  cmd.add_option("--iso", args.isos,
-                 "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume (of the scene file's volumes when "
-                 "no --volume is given); repeatable");
-  cmd.add_option("--slice", args.slices,
-                 "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
-                 "repeatable");
-  cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
-}
-
-SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems) {
-  SceneSpec scene;
-  if (!args.scene.empty()) scene = load_scene_file(args.scene);
-  if (dems.empty()) dems = scene.dems;
-  if (dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
-  scene.dems = dems;
-  const std::string& frame = args.volume_frame;
-  if (!frame.empty()) {
-    try {
-      volume::parse_frame(frame);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(quote("--volume-frame", frame) + e.what());
-    }
-  }
-  std::vector<volume::IsoSpec> iso_specs;
-  for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
-  std::vector<volume::SliceSpec> slice_specs;
-  for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
-  if (args.volumes.empty()) {
-    for (VolumeSpec& v : scene.volumes) {
-      if (!iso_specs.empty()) v.isosurfaces = iso_specs;
-      if (!slice_specs.empty()) v.slices = slice_specs;
-    }
-    return scene;
-  }
-  for (const auto& f : args.volumes) {
-    VolumeSpec v;
-    v.file = f;
-    v.field = args.field;
-    v.frame = frame;
-    v.isosurfaces = iso_specs;
-    v.slices = slice_specs;
-    scene.volumes.push_back(std::move(v));
-  }
-  return scene;
-}
-
 Tint parse_tint(std::string_view text) {
   if (text == "atlas") return Tint::kAtlas;
   if (text == "relative") return Tint::kRelative;
@@ -165,4 +153,13 @@ Tint parse_tint(std::string_view text) {
   throw std::invalid_argument(quote("--tint", text) + "unknown tint (expected atlas, relative or grey)");
 }
 
-}  // namespace terravol::app
+const char* tint_name(Tint tint) {
+  switch (tint) {
+    case Tint::kAtlas: return "atlas";
+    case Tint::kRelative: return "relative";
+    case Tint::kGrey: return "grey";
+  }
+  return "?";
+}
+
+}  // namespace terravol::app::scene

@@ -1,65 +1,74 @@
-// The options of `terravol render`, and the parsers of its compound values. The parsers throw
-// std::invalid_argument with a one-line message that names the option and the text.
+// How a scene is drawn, as a scene file's "render" object and the command line both name it:
+// the draw orders, the parsers of the options' compound values, and the one table of which
+// source wins (an option given on the command line, else the scene file, else the default),
+// shared by every command that reads a scene (render, view, fly). No VTK and no CLI11 here.
+// The parsers throw std::invalid_argument with a one-line message that names the option and
+// the text.
 #pragma once
 
-#include <CLI/CLI.hpp>
-
-#include <filesystem>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <vector>
 
-#include "app/camera.h"
-#include "app/scene_file.h"
-#include "app/volume_layer.h"
-#include "app/terrain_colors.h"
-#include "app/terrain_renderer.h"
+#include "app/scene/camera.h"
+#include "app/scene/terrain_colors.h"
 #include "mrbsp/terrain_tree.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
-struct RenderOptions {
-  std::vector<std::filesystem::path> dems;  // files or folders, one mosaic
-  CameraPose pose;
-  bool agl = false;                // pose.alt is above the ground under the camera
-  std::filesystem::path output;    // PNG
-  double fov_y_deg = 45.0;         // vertical, (0, 180)
-  RenderSettings render;           // size, order, wireframe, lod colours, background
-  mrbsp::TraversalOptions traversal;
-  int levels = 0;                  // 0: default_levels(window)
-  int max_window = 1024;           // cells, a power of two >= 2
-  ShadingOptions shading;
-  double haze_km = 60.0;           // RenderSettings::haze_distance, km; 0: none
-  bool force = false;              // replace existing outputs
-  std::filesystem::path stats;     // JSON, optional
-  std::filesystem::path export_vtp;  // optional
-  std::vector<VolumeSpec> volumes;   // RF volumes and their styles
-  bool legend = true;                // a colour legend when volumes are drawn
+struct SceneSpec;
+
+enum class DrawOrder : std::uint8_t {
+  kBsp,      // the tree's back-to-front order, depth test off (OrderedPolyDataMapper)
+  kZBuffer,  // the same triangles in the same order, vtkPolyDataMapper with the depth test on
+  // The references for translucency, all with the terrain opaque and depth-tested and the
+  // merged triangles of the same frame in a second, translucent actor:
+  kPeel,  // VTK's depth peeling, occlusion ratio 0; with no limit on peels (the default): exact
+  kVtk,   // VTK 9.1's default translucent pass: weighted blended order-independent
+          // translucency (McGuire and Bavoil 2013), depth test on
+  kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
+};
+
+// Isosurfaces and slices are decimated to this many triangles each before merging (0: all).
+inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
+
+// The "render" object of a scene file (docs/scene-file.md), or what a command line gave: every
+// key optional; what is absent is decided by the next source (overlay) or the default
+// (resolve_style). Names (metric, order, tint) as the options spell them.
+struct SceneStyle {
+  std::optional<int> width, height;
+  std::optional<double> threshold;
+  std::optional<std::string> lod_metric, order, tint;
+  std::optional<int> window;
+  std::optional<double> haze_km, sun_azimuth, sun_elevation;
+  std::optional<bool> legend;
+  std::optional<std::size_t> surface_triangles;
+};
+
+// A style with every key decided.
+struct Style {
+  int width = 1280, height = 720;   // pixels
+  mrbsp::TraversalOptions traversal;  // metric and threshold (pixels, or square pixels for area)
+  DrawOrder order = DrawOrder::kBsp;
+  ShadingOptions shading;           // tint and sun
+  int window = 1024;                // largest window side, cells, a power of two
+  double haze_km = 60.0;            // 0: none
+  bool legend = true;               // a colour legend when volumes are drawn
   std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
 };
 
-// The scene options `render` and `view` share: --scene, --volume, --field, --volume-frame,
-// --iso, --slice, --no-legend.
-struct SceneArgs {
-  std::filesystem::path scene;
-  std::vector<std::filesystem::path> volumes;
-  std::vector<std::string> isos, slices;
-  std::string volume_frame, field;
-  bool no_legend = false;
-};
-void add_scene_options(CLI::App& cmd, SceneArgs& args);
+// The precedence table, in one place: every key set in `given` (the command line) wins over the
+// same key of `file` (the scene file); a key set in neither stays unset.
+SceneStyle overlay(const SceneStyle& file, const SceneStyle& given);
 
-// The scene the command line describes: the --scene file (empty without one), its DEMs
-// replaced by `dems` when not empty (else `dems` gets the file's; none at all is an error),
-// and its volumes joined with the --volume files: each --volume FILE (read as --field, placed
-// by --volume-frame) gets the --iso and --slice styles; with no --volume, non-empty --iso or
-// --slice lists replace the styles of every volume of the file. Throws std::invalid_argument
-// for a bad file or bad --iso, --slice or --volume-frame text.
-SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
+// Every key of `style` decided: its value, else Style's default (the threshold's default is
+// the metric's, mrbsp::default_threshold). Throws std::invalid_argument naming the option for a
+// name that does not parse or a threshold that is not a positive finite number of pixels.
+Style resolve_style(const SceneStyle& style);
 
-// The camera `render` and `view` start from: --camera TEXT when given (camera_text not null),
-// else the scene file's camera, whose agl is or-ed into `agl` and whose field of view replaces
+// The camera a command starts from: --camera TEXT when given (camera_text not null), else the
+// scene file's camera, whose agl is or-ed into `agl` and whose field of view replaces
 // `fov_y_deg` unless --fov was given; nothing when neither has one. Throws what
 // parse_camera_pose throws.
 std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::string* camera_text, bool fov_given,
@@ -69,18 +78,21 @@ std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::strin
 // Throws std::invalid_argument unless it is a positive finite number of pixels.
 float resolve_threshold(bool given, double option, const std::optional<double>& file, mrbsp::LodMetric metric);
 
-// Throws std::invalid_argument naming --fov, --window, --haze or --levels when the field of
-// view is not within (0, 180) degrees, the window not a power of two >= 2, the haze distance
-// not >= 0 km, or levels (when given) < 1.
-void check_view_options(double fov_y_deg, int max_window, double haze_km, bool levels_given, int levels);
+// Throws std::invalid_argument naming --fov, --window, --haze, --levels or --sun-elevation
+// when the field of view is not within (0, 180) degrees, the window not a power of two >= 2,
+// the haze distance not >= 0 km, levels (when given) < 1, or the sun's elevation not within
+// (0, 90] degrees.
+void check_view_options(double fov_y_deg, const Style& style, bool levels_given, int levels);
 
 // "WxH", each 1..16384.
 void parse_size(std::string_view text, int& width, int& height);
 // "R,G,B", each 0..255.
 Rgb parse_rgb(std::string_view option, std::string_view text);
 mrbsp::LodMetric parse_metric(std::string_view text);  // error | area
+const char* metric_name(mrbsp::LodMetric metric);      // the inverse of parse_metric
 DrawOrder parse_order(std::string_view text);          // bsp | zbuffer | peel | vtk | sort
 const char* order_name(DrawOrder order);               // the inverse of parse_order
 Tint parse_tint(std::string_view text);                // atlas | relative | grey
+const char* tint_name(Tint tint);                      // the inverse of parse_tint ("grey")
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,4 +1,4 @@
-#include "app/terrain_colors.h"
+#include "app/scene/terrain_colors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <glm/geometric.hpp>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -188,4 +188,4 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   return out;
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -12,9 +12,10 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 using Rgba = std::array<std::uint8_t, 4>;
+using Rgb = std::array<std::uint8_t, 3>;
 
 enum class Tint : std::uint8_t {
   kAtlas,     // absolute: green lowlands, tan and brown hills, grey rock, snow above ~3800 m
@@ -79,4 +80,4 @@ std::array<std::array<std::uint8_t, 3>, 2> sky_gradient(double pitch_deg, double
 // Scales the RGB of a colour by `shade`, clamped to 255; alpha kept.
 Rgba shaded(const Rgba& c, float shade);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

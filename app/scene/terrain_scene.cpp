@@ -1,4 +1,4 @@
-#include "app/terrain_scene.h"
+#include "app/scene/terrain_scene.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,7 +11,7 @@
 
 #include "io/void_fill.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -178,4 +178,4 @@ double TerrainScene::far_plane(const glm::dvec3& eye) const {
   return far * 1.05 + 100.0;
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

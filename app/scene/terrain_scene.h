@@ -12,7 +12,7 @@
 #include "io/scene_frame.h"
 #include "mrbsp/terrain_tree.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // A window of the mosaic lattice: rows [row0, row0 + cells] and columns [col0, col0 + cells]
 // (cells + 1 samples per side; row 0 north, as in io::Grid).
@@ -133,4 +133,4 @@ class TerrainScene {
   mrbsp::TerrainTree tree_;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

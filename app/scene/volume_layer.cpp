@@ -1,4 +1,4 @@
-#include "app/volume_layer.h"
+#include "app/scene/volume_layer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -7,12 +7,12 @@
 #include <limits>
 #include <stdexcept>
 
-#include "app/ground_grid.h"
+#include "app/scene/ground_grid.h"
 #include "volume/colormap.h"
 #include "volume/geometry.h"
 #include "volume/readers.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 namespace {
 
@@ -160,8 +160,8 @@ void VolumeLayer::set_isosurface(std::size_t volume, std::size_t iso, const volu
   figures_.geometry_ms = ms_since(t0);
 }
 
-TerrainRenderer::Legend VolumeLayer::legend() const {
-  TerrainRenderer::Legend legend;
+Legend VolumeLayer::legend() const {
+  Legend legend;
   for (const auto& v : volumes_) {
     if (!v->spec.visible || (v->spec.slices.empty() && v->spec.isosurfaces.empty())) continue;
     const std::string units = v->data.units.empty() ? "" : " (" + v->data.units + ")";
@@ -188,4 +188,4 @@ TerrainRenderer::Legend VolumeLayer::legend() const {
   return legend;
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -7,16 +7,17 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
-#include "app/scene_file.h"
-#include "app/terrain_renderer.h"
-#include "app/terrain_scene.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/terrain_colors.h"
+#include "app/scene/terrain_scene.h"
 #include "io/mosaic.h"
 #include "io/scene_frame.h"
 #include "volume/geometry.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 
 // What merging the volumes cost: the geometry (extraction) and the tree's merge.
 struct MergeFigures {
@@ -25,7 +26,15 @@ struct MergeFigures {
   double geometry_ms = 0, merge_ms = 0;
 };
 
-inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
+// The colour legend of the volumes (the renderer draws it in the lower right): continuous,
+// colours sampled evenly over [lo, hi]; or discrete (isosurfaces), one swatch per entry of
+// `labels`, colors[k] for labels[k]. Empty colours: no legend.
+struct Legend {
+  std::string title;
+  double lo = 0.0, hi = 1.0;
+  std::vector<Rgb> colors;
+  std::vector<std::string> labels;  // empty: continuous
+};
 
 class VolumeLayer {
  public:
@@ -60,7 +69,7 @@ class VolumeLayer {
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
   // slice's range, else a swatch per isosurface. Empty (no colours) when there is none.
-  TerrainRenderer::Legend legend() const;
+  Legend legend() const;
 
  private:
   struct Loaded;
@@ -69,4 +78,4 @@ class VolumeLayer {
   std::size_t max_triangles_ = kDefaultSurfaceTriangles;
 };
 
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

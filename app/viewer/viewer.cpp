@@ -5,7 +5,7 @@
 // if the camera nears the window's edge, traverse the tree, replace the triangle list, draw,
 // write the status file. Nothing is drawn while nothing changes. The interactor's own
 // rendering is switched off so that widgets and expose events only ask for a frame.
-#include "app/viewer.h"
+#include "app/viewer/viewer.h"
 
 #include <nlohmann/json.hpp>
 
@@ -43,16 +43,16 @@
 #include <string>
 #include <utility>
 
-#include "app/camera_path.h"
-#include "app/png_output.h"
-#include "app/terrain_renderer.h"
-#include "app/terrain_scene.h"
-#include "app/volume_layer.h"
-#include "app/write_file.h"
+#include "app/output/png_output.h"
+#include "app/output/write_file.h"
+#include "app/render/terrain_renderer.h"
+#include "app/scene/camera_path.h"
+#include "app/scene/terrain_scene.h"
+#include "app/scene/volume_layer.h"
 #include "io/error.h"
 #include "io/mosaic.h"
 
-namespace terravol::app {
+namespace terravol::app::viewer {
 
 const char* const kViewKeys =
     "W / S        forward / back, along the view\n"
@@ -127,8 +127,8 @@ class ViewerStyle;
 
 // A moved window read from the mosaic and shaded, ready to slide to.
 struct PreparedSlide {
-  SceneWindow window;
-  TerrainShading lattice, vertices;
+  scene::SceneWindow window;
+  scene::TerrainShading lattice, vertices;
   double read_ms = 0, shade_ms = 0;
 };
 
@@ -163,11 +163,11 @@ class Viewer {
   void update_overlay(double agl, double speed);
   void write_status(double agl, double speed, const mrbsp::Camera& camera);
   void save_screenshot();
-  FlightInput input() const;
+  scene::FlightInput input() const;
   // Held now, or pressed since the last tick (so that a tap shorter than a tick still moves).
   bool held(const char* key) const { return held_.count(key) > 0 || tapped_.count(key) > 0; }
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
-  void clamp_to_mosaic(CameraPose& p) const;
+  void clamp_to_mosaic(scene::CameraPose& p) const;
   void volume_key(const std::string& key);
   void record_key();
   void save_path();
@@ -175,18 +175,18 @@ class Viewer {
 
   ViewOptions o_;
   io::Mosaic mosaic_;
-  std::unique_ptr<TerrainScene> scene_;
-  TerrainShading lattice_;    // the window's lattice shading (its colours are the texture)
-  VolumeLayer volumes_;
+  std::unique_ptr<scene::TerrainScene> scene_;
+  scene::TerrainShading lattice_;    // the window's lattice shading (its colours are the texture)
+  scene::VolumeLayer volumes_;
   std::size_t selected_volume_ = 0;
-  std::vector<PathKey> keys_;  // recorded keyframes (K), saved by J
+  std::vector<scene::PathKey> keys_;  // recorded keyframes (K), saved by J
   Clock::time_point first_key_time_;
   double last_merge_ms_ = 0;  // the last interactive change of a volume, extraction to upload
   std::future<PreparedSlide> pending_slide_;  // destroyed (waited for) before the mosaic
-  std::unique_ptr<TerrainRenderer> renderer_;
+  std::unique_ptr<render::TerrainRenderer> renderer_;
   mrbsp::Frame frame_;
-  CameraPose pose_, start_pose_;
-  FlightSettings flight_;
+  scene::CameraPose pose_, start_pose_;
+  scene::FlightSettings flight_;
   mrbsp::LodMetric metric_;
   double threshold_[2];  // per metric, [0] area, [1] error: each keeps its own
   bool lod_colors_, wireframe_, auto_slide_, help_ = false;
@@ -263,9 +263,9 @@ class ViewerStyle : public vtkInteractorStyle {
 
 vtkStandardNewMacro(ViewerStyle);
 
-CameraPose default_pose(const io::Mosaic& m) {
+scene::CameraPose default_pose(const io::Mosaic& m) {
   const io::Georef& g = m.georef();
-  CameraPose p;
+  scene::CameraPose p;
   p.lat = g.y0 - (m.rows() - 1) * g.dy / 2.0;
   p.lon = std::remainder(g.x0 + (m.cols() - 1) * g.dx / 2.0, 360.0);
   p.alt = 1500.0;  // above the ground
@@ -295,13 +295,13 @@ Viewer::Viewer(const ViewOptions& options)
     : o_(options),
       mosaic_(io::Mosaic::open(options.dems)),
       flight_(options.flight),
-      metric_(options.traversal.metric),
+      metric_(options.style.traversal.metric),
       lod_colors_(options.lod_colors),
       wireframe_(options.wireframe),
       auto_slide_(options.auto_slide) {
   threshold_[0] = mrbsp::default_threshold(mrbsp::LodMetric::kArea);
   threshold_[1] = mrbsp::default_threshold(mrbsp::LodMetric::kError);
-  threshold() = options.traversal.threshold_px;
+  threshold() = options.style.traversal.threshold_px;
 
   // The camera, inside the mosaic and above its ground.
   const bool given = options.pose.has_value();
@@ -316,9 +316,9 @@ Viewer::Viewer(const ViewOptions& options)
                              " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
                              ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
   }
-  require_x_display();
-  const WindowChoice window = choose_window(mosaic_.rows(), mosaic_.cols(), row, col, o_.max_window);
-  scene_ = std::make_unique<TerrainScene>(mosaic_, window, o_.levels > 0 ? o_.levels : default_levels(window.cells));
+  render::require_x_display();
+  const scene::WindowChoice window = scene::choose_window(mosaic_.rows(), mosaic_.cols(), row, col, o_.style.window);
+  scene_ = std::make_unique<scene::TerrainScene>(mosaic_, window, o_.levels > 0 ? o_.levels : scene::default_levels(window.cells));
   const double ground = scene_->ground_height(pose_.lat, pose_.lon);
   if (agl) pose_.alt += ground;
   if (pose_.alt <= ground) {
@@ -330,23 +330,24 @@ Viewer::Viewer(const ViewOptions& options)
   start_pose_ = pose_;
 
   // The renderer, on screen.
-  RenderSettings settings;
-  settings.width = o_.width;
-  settings.height = o_.height;
+  render::RenderSettings settings;
+  settings.width = o_.style.width;
+  settings.height = o_.style.height;
+  settings.order = o_.style.order;
   settings.lod_colors = lod_colors_;
   settings.wireframe = wireframe_;
   settings.gradient = true;
-  settings.haze_color = kHorizon;
-  settings.haze_distance = o_.haze_km * 1000.0;
+  settings.haze_color = scene::kHorizon;
+  settings.haze_distance = o_.style.haze_km * 1000.0;
   settings.offscreen = false;
-  volumes_ = VolumeLayer(o_.volumes, mosaic_, scene_->frame());
+  volumes_ = scene::VolumeLayer(o_.volumes, mosaic_, scene_->frame(), o_.style.surface_triangles);
   volumes_.merge_into(*scene_);
-  lattice_ = shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), o_.shading);
+  lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), o_.style.shading);
   const mrbsp::TerrainTree& tree = scene_->tree();
-  renderer_ = std::make_unique<TerrainRenderer>(tree.positions(),
-                                                vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
-                                                settings, ColorTexture{scene_->cells() + 1, lattice_.rgba});
-  if (o_.legend) renderer_->set_legend(volumes_.legend());
+  renderer_ = std::make_unique<render::TerrainRenderer>(tree.positions(),
+                                                scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+                                                settings, render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  if (o_.style.legend) renderer_->set_legend(volumes_.legend());
   vtkRenderWindow* win = renderer_->window();
   std::string title = "Terravol view - " + o_.dems.front().filename().string();
   if (o_.dems.size() > 1) title += " + " + std::to_string(o_.dems.size() - 1) + " more";
@@ -466,8 +467,8 @@ void Viewer::run() {
   std::fflush(stdout);
 }
 
-FlightInput Viewer::input() const {
-  FlightInput in;
+scene::FlightInput Viewer::input() const {
+  scene::FlightInput in;
   in.forward = int(held("w")) - int(held("s"));
   in.right = int(held("d")) - int(held("a"));
   in.up = int(held("r") || held("Prior")) - int(held("f") || held("Next"));
@@ -535,7 +536,7 @@ void Viewer::button(bool down, int x, int y) {
 
 void Viewer::mouse_move(int x, int y) {
   if (!dragging_) return;
-  pose_ = look(pose_, x - drag_x_, y - drag_y_, flight_);
+  pose_ = scene::look(pose_, x - drag_x_, y - drag_y_, flight_);
   drag_x_ = x;
   drag_y_ = y;
   dirty_ = true;
@@ -550,7 +551,7 @@ void Viewer::wheel(int clicks) {
 // keys held now would go elsewhere; stop rather than fly on.
 void Viewer::leave() { held_.clear(); }
 
-void Viewer::clamp_to_mosaic(CameraPose& p) const {
+void Viewer::clamp_to_mosaic(scene::CameraPose& p) const {
   const io::Georef& g = mosaic_.georef();
   const double south = g.y0 - (mosaic_.rows() - 1) * g.dy, west = g.x0;
   p.lat = std::clamp(p.lat, south, g.y0);
@@ -572,10 +573,10 @@ void Viewer::tick() {
   // At most a quarter second per tick, so a stall (a slide, a busy machine) is no leap.
   const double dt = std::min(std::chrono::duration<double>(now - last_tick_).count(), 0.25);
   last_tick_ = now;
-  const FlightInput in = input();
+  const scene::FlightInput in = input();
   if (in.moving()) {
-    const TerrainScene& scene = *scene_;
-    pose_ = fly(pose_, in, dt, scene.frame(),
+    const scene::TerrainScene& scene = *scene_;
+    pose_ = scene::fly(pose_, in, dt, scene.frame(),
                 [&scene](double lat, double lon) { return scene.ground_height(lat, lon); }, flight_);
     clamp_to_mosaic(pose_);
     dirty_ = true;
@@ -610,7 +611,7 @@ void Viewer::volume_key(const std::string& key) {
       volumes_.set_visible(v, !volumes_.spec(v).visible);
       what = "volume " + key + (volumes_.spec(v).visible ? " shown" : " hidden");
     } else if (key == "bracketleft" || key == "bracketright") {
-      const VolumeSpec& spec = volumes_.spec(selected_volume_);
+      const scene::VolumeSpec& spec = volumes_.spec(selected_volume_);
       if (spec.slices.empty()) {
         message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no slice";
         return;
@@ -624,7 +625,7 @@ void Viewer::volume_key(const std::string& key) {
                     degrees ? " deg" : " m");
       what = b;
     } else {
-      const VolumeSpec& spec = volumes_.spec(selected_volume_);
+      const scene::VolumeSpec& spec = volumes_.spec(selected_volume_);
       if (spec.isosurfaces.empty()) {
         message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no isosurface";
         return;
@@ -643,7 +644,7 @@ void Viewer::volume_key(const std::string& key) {
   const double geometry_ms = volumes_.figures().geometry_ms;
   volumes_.merge_into(*scene_);
   upload_vertices();
-  if (o_.legend) renderer_->set_legend(volumes_.legend());
+  if (o_.style.legend) renderer_->set_legend(volumes_.legend());
   last_merge_ms_ = ms_between(t0, Clock::now());
   char b[160];
   std::snprintf(b, sizeof b, "%s: %.0f ms (geometry %.0f, merge %.0f)", what.c_str(), last_merge_ms_, geometry_ms,
@@ -655,9 +656,9 @@ void Viewer::volume_key(const std::string& key) {
 void Viewer::record_key() {
   const Clock::time_point now = Clock::now();
   if (keys_.empty()) first_key_time_ = now;
-  PathKey k;
+  scene::PathKey k;
   k.t = std::chrono::duration<double>(now - first_key_time_).count();
-  if (!keys_.empty()) k.t = std::max(k.t, keys_.back().t + kMinKeyGap);
+  if (!keys_.empty()) k.t = std::max(k.t, keys_.back().t + scene::kMinKeyGap);
   k.lat = pose_.lat;
   k.lon = pose_.lon;
   k.alt = pose_.alt;  // above the datum
@@ -687,8 +688,8 @@ void Viewer::save_path() {
   }
   const std::filesystem::path out = o_.record.empty() ? std::filesystem::path("terravol-path.json") : o_.record;
   try {
-    const std::string text = path_to_json(scene, keys_).dump(2) + "\n";
-    write_file_atomically(out, std::vector<std::uint8_t>(text.begin(), text.end()), true);
+    const std::string text = scene::path_to_json(scene, keys_).dump(2) + "\n";
+    output::write_file_atomically(out, std::vector<std::uint8_t>(text.begin(), text.end()), true);
     message_ = "saved " + std::to_string(keys_.size()) + " keyframes to " + out.string();
   } catch (const std::exception& e) {
     message_ = std::string("saving the path failed: ") + e.what();
@@ -697,8 +698,8 @@ void Viewer::save_path() {
 
 void Viewer::upload_vertices() {
   const mrbsp::TerrainTree& tree = scene_->tree();
-  renderer_->replace_vertices(tree.positions(), vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
-                              ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  renderer_->replace_vertices(tree.positions(), scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+                              render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
 void Viewer::slider_moved() {
@@ -741,20 +742,20 @@ void Viewer::start_slide() {
   if (pending_slide_.valid()) return;
   double row = 0, col = 0;
   lattice_position(mosaic_, pose_.lat, pose_.lon, row, col);
-  const WindowChoice& now = scene_->window();
+  const scene::WindowChoice& now = scene_->window();
   const int step = 1 << (scene_->tree().levels() - 1);  // samples across one coarsest-level cell
-  const WindowChoice next = plan_slide(now, mosaic_.rows(), mosaic_.cols(), row, col, step);
+  const scene::WindowChoice next = scene::plan_slide(now, mosaic_.rows(), mosaic_.cols(), row, col, step);
   if (next.row0 == now.row0 && next.col0 == now.col0) return;
   const mrbsp::TerrainTree& tree = scene_->tree();
   pending_slide_ = std::async(std::launch::async, [mosaic = &mosaic_, next, frame = scene_->frame(),
-                                                   shading = o_.shading, base = tree.merged_base(),
+                                                   shading = o_.style.shading, base = tree.merged_base(),
                                                    merged = tree.merged_colors()] {
     PreparedSlide p;
     const auto t0 = Clock::now();
-    p.window = read_scene_window(*mosaic, next, frame);
+    p.window = scene::read_scene_window(*mosaic, next, frame);
     const auto t1 = Clock::now();
-    p.lattice = shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, shading);
-    p.vertices = vertex_shading(p.lattice, base, merged);
+    p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, shading);
+    p.vertices = scene::vertex_shading(p.lattice, base, merged);
     p.read_ms = ms_between(t0, t1);
     p.shade_ms = ms_between(t1, Clock::now());
     return p;
@@ -782,9 +783,9 @@ void Viewer::finish_slide() {
   const auto t1 = Clock::now();
   if (volumes_.size() > 0) {
     // The merged vertices were made anew by the slide: their count and colours changed.
-    p.vertices = vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
+    p.vertices = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
   }
-  renderer_->replace_vertices(scene_->tree().positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  renderer_->replace_vertices(scene_->tree().positions(), p.vertices, render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
   const auto t2 = Clock::now();
   slide_parts_ = {p.read_ms, p.shade_ms, ms_between(t0, t1), ms_between(t1, t2)};
   last_slide_ms_ = ms_between(t0, t2);
@@ -800,15 +801,15 @@ void Viewer::draw_frame() {
   const int width = std::max(size[0], 1), height = std::max(size[1], 1);
   const double ground = scene_->ground_height(pose_.lat, pose_.lon);
   const double agl = pose_.alt - ground;
-  const double speed = flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
+  const double speed = scene::flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
   const mrbsp::Camera camera =
-      make_scene_camera(scene_->frame(), pose_, pose_.alt, o_.fov_y_deg, width, height, near_plane_for(agl));
+      scene::make_scene_camera(scene_->frame(), pose_, pose_.alt, o_.fov_y_deg, width, height, scene::near_plane_for(agl));
   renderer_->set_camera(camera, scene_->far_plane(camera.eye));
-  const auto sky = sky_gradient(pose_.pitch_deg, o_.fov_y_deg);
+  const auto sky = scene::sky_gradient(pose_.pitch_deg, o_.fov_y_deg);
   renderer_->renderer()->SetBackground(sky[0][0] / 255.0, sky[0][1] / 255.0, sky[0][2] / 255.0);
   renderer_->renderer()->SetBackground2(sky[1][0] / 255.0, sky[1][1] / 255.0, sky[1][2] / 255.0);
 
-  mrbsp::TraversalOptions traversal = o_.traversal;
+  mrbsp::TraversalOptions traversal = o_.style.traversal;
   traversal.metric = metric_;
   traversal.threshold_px = static_cast<float>(threshold());
   const auto t1 = Clock::now();
@@ -838,7 +839,7 @@ void Viewer::draw_frame() {
 // quarter second has passed: redrawing it every frame cost about 7 ms per frame. tick() brings
 // a last frame when the camera stops, so the figures do not stay stale.
 void Viewer::update_overlay(double agl, double speed) {
-  const WindowChoice& w = scene_->window();
+  const scene::WindowChoice& w = scene_->window();
   const bool error = metric_ == mrbsp::LodMetric::kError;
   char settings[512];
   std::snprintf(settings, sizeof settings,
@@ -875,7 +876,7 @@ void Viewer::save_screenshot() {
     }
   }
   try {
-    write_png(path, window_png(renderer_->window()), true);
+    output::write_png(path, output::window_png(renderer_->window()), true);
     ++screenshots_;
     last_screenshot_ = path;
     message_ = "wrote " + path.string();
@@ -888,8 +889,8 @@ void Viewer::save_screenshot() {
 
 void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera) {
   if (o_.status.empty()) return;
-  const WindowChoice& w = scene_->window();
-  const WindowBounds b = scene_->bounds();
+  const scene::WindowChoice& w = scene_->window();
+  const scene::WindowBounds b = scene_->bounds();
   const int* size = renderer_->window()->GetSize();
   // The slider's knob centre at the range's ends, in window pixels from the top left
   // (vtkSliderRepresentation2D: caps at both ends, the knob slides between them).
@@ -929,7 +930,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["slide_pending"] = pending_slide_.valid();
   j["volumes"] = ordered_json::array();
   for (std::size_t v = 0; v < volumes_.size(); ++v) {
-    const VolumeSpec& spec = volumes_.spec(v);
+    const scene::VolumeSpec& spec = volumes_.spec(v);
     ordered_json jv;
     jv["visible"] = spec.visible;
     jv["isovalues"] = ordered_json::array();
@@ -964,7 +965,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["screenshot"] = last_screenshot_.string();
   const std::string text = j.dump(2) + "\n";
   try {
-    write_file_atomically(o_.status, std::vector<std::uint8_t>(text.begin(), text.end()), true);
+    output::write_file_atomically(o_.status, std::vector<std::uint8_t>(text.begin(), text.end()), true);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "terravol: %s\n", e.what());
   }
@@ -977,4 +978,4 @@ void run_viewer(const ViewOptions& options) {
   viewer.run();
 }
 
-}  // namespace terravol::app
+}  // namespace terravol::app::viewer

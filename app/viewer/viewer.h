@@ -8,37 +8,34 @@
 #include <optional>
 #include <vector>
 
-#include "app/camera.h"
-#include "app/flight.h"
-#include "app/scene_file.h"
-#include "app/terrain_colors.h"
-#include "mrbsp/terrain_tree.h"
+#include "app/scene/camera.h"
+#include "app/scene/flight.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/style.h"
 
-namespace terravol::app {
+namespace terravol::app::viewer {
 
 struct ViewOptions {
   std::vector<std::filesystem::path> dems;  // files or folders, one mosaic
-  std::optional<CameraPose> pose;           // none: above the mosaic's centre, looking north
+  std::optional<scene::CameraPose> pose;    // none: scene::default_pose (above the mosaic's centre)
   bool agl = false;                         // pose->alt is above the ground under the camera
-  int width = 1280, height = 720;           // window, pixels
   double fov_y_deg = 45.0;                  // vertical, (0, 180)
-  mrbsp::TraversalOptions traversal;        // metric and its threshold at the start
+  // The scene file's style overridden by the options: the window's size, the LOD metric and
+  // threshold at the start, the draw order, shading, window, haze, legend and the volumes'
+  // triangle budget.
+  scene::Style style;
   int levels = 0;                           // 0: default_levels(window)
-  int max_window = 1024;                    // cells, a power of two >= 2
-  ShadingOptions shading;
-  double haze_km = 60.0;                    // 0: none
-  FlightSettings flight;                    // speed_factor from --speed
+  scene::FlightSettings flight;             // speed_factor from --speed
   bool lod_colors = false, wireframe = false;
   bool auto_slide = true;
   // After every rendered frame, a small JSON of the viewer's state (written to a temporary
   // name and renamed); empty: none.
   std::filesystem::path status;
-  std::vector<VolumeSpec> volumes;  // RF volumes and their styles
+  std::vector<scene::VolumeSpec> volumes;  // RF volumes and their styles
   std::filesystem::path scene_file;  // the --scene file, if any (a recorded path refers to it)
   // Where the save-path key writes the recorded keyframes (a camera path for terravol fly,
   // atomically, replaced each time); empty: terravol-path.json in the current folder.
   std::filesystem::path record;
-  bool legend = true;               // a colour legend when volumes are drawn
   // Where the screenshot key writes (replaced each time, atomically); empty: the next free
   // terravol-view-NNN.png in the current folder.
   std::filesystem::path screenshot;
@@ -52,4 +49,4 @@ extern const char* const kViewKeys;
 // mosaic or under the ground, or without an X display; io::FormatError from the DEMs.
 void run_viewer(const ViewOptions& options);
 
-}  // namespace terravol::app
+}  // namespace terravol::app::viewer

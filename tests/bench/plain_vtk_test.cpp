@@ -15,10 +15,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "app/camera.h"
-#include "app/png_output.h"
-#include "app/terrain_colors.h"
-#include "app/terrain_renderer.h"
+#include "app/output/png_output.h"
+#include "app/render/terrain_renderer.h"
+#include "app/scene/camera.h"
+#include "app/scene/terrain_colors.h"
 #include "bench/plain_vtk.h"
 #include "mrbsp/terrain_tree.h"
 #include "require_display.h"
@@ -40,7 +40,7 @@ struct Lattice {
   int cells;
   std::vector<double> xs, ys;
   std::vector<float> z;
-  app::TerrainShading shading;  // shade_terrain: atlas tint with hillshade, fixed by the heights
+  app::scene::TerrainShading shading;  // shade_terrain: atlas tint with hillshade, fixed by the heights
 
   Lattice(int n, double spacing) : cells(n) {
     for (int i = 0; i <= n; ++i) {
@@ -56,7 +56,7 @@ struct Lattice {
             120.0 * std::sin(xs[i] / (3.1 * spacing)) * std::cos(ys[j] / (4.3 * spacing));
         z.push_back(static_cast<float>(h));
       }
-    shading = app::shade_terrain(n, xs, ys, z, z, {});
+    shading = app::scene::shade_terrain(n, xs, ys, z, z, {});
   }
   mrbsp::TerrainWindow window() const { return {cells, xs, ys, z}; }
   double size() const { return xs.back() - xs.front(); }
@@ -157,11 +157,11 @@ TEST(PlainVtkLattice, RefusesAnEmptyLattice) {
 
 TEST(PlainVtkScene, RefusesMismatchedInput) {
   const std::vector<glm::vec3> p(4, glm::vec3(0.0f));
-  const std::vector<app::Rgba> c(3);
+  const std::vector<app::scene::Rgba> c(3);
   const std::vector<std::uint32_t> t{0, 1, 2};
   const std::vector<std::uint32_t> bad{0, 1, 4};
   EXPECT_THROW(PlainVtkScene(p, c, t, {}, {}, {}, {}), std::invalid_argument);  // colour count
-  const std::vector<app::Rgba> c4(4);
+  const std::vector<app::scene::Rgba> c4(4);
   EXPECT_THROW(PlainVtkScene(p, c4, bad, {}, {}, {}, {}),
                std::invalid_argument);  // index 4 of 4 vertices
   EXPECT_THROW(PlainVtkScene(p, c4, std::vector<std::uint32_t>{0, 1}, {}, {}, {}, {}),
@@ -211,19 +211,19 @@ TEST(PlainVtkScene, FullResolutionTerrainMatchesTerravolsOwnRenderer) {
   mrbsp::TraversalOptions full;
   full.full_res = true;
   tree.traverse(camera, full, frame);
-  const app::TerrainShading shading = app::vertex_shading(lattice.shading, tree.merged_base(), {});
-  for (app::DrawOrder order : {app::DrawOrder::kBsp, app::DrawOrder::kZBuffer}) {
-    app::RenderSettings settings;
+  const app::scene::TerrainShading shading = app::scene::vertex_shading(lattice.shading, tree.merged_base(), {});
+  for (app::scene::DrawOrder order : {app::scene::DrawOrder::kBsp, app::scene::DrawOrder::kZBuffer}) {
+    app::render::RenderSettings settings;
     settings.width = kW;
     settings.height = kH;
     settings.order = order;
     settings.gradient = false;
     settings.background = options.background;
-    app::TerrainRenderer terravol(tree.positions(), shading, settings);
+    app::render::TerrainRenderer terravol(tree.positions(), shading, settings);
     terravol.set_camera(camera, far_plane);
     terravol.set_frame(frame);
     terravol.render();
-    const std::vector<std::uint8_t> terravol_rgb = app::window_rgb(terravol.window());
+    const std::vector<std::uint8_t> terravol_rgb = app::render::window_rgb(terravol.window());
     ASSERT_EQ(terravol_rgb.size(), plain_rgb.size());
 
     // Terrain covers most of the image, so a blank or misplaced image could not pass.
@@ -236,7 +236,7 @@ TEST(PlainVtkScene, FullResolutionTerrainMatchesTerravolsOwnRenderer) {
     const double exact = differing_share(plain_rgb, terravol_rgb, 0);
     const double visible = differing_share(plain_rgb, terravol_rgb, 8);
     std::printf("%s: %.4f%% of pixels differ at all, %.4f%% by more than 8 levels\n",
-                order == app::DrawOrder::kBsp ? "bsp" : "zbuffer", 100.0 * exact, 100.0 * visible);
+                order == app::scene::DrawOrder::kBsp ? "bsp" : "zbuffer", 100.0 * exact, 100.0 * visible);
     // Same triangles, same vertex buffer precision, same transform: only the visible-surface
     // decision can differ, at silhouettes where the tree's order and the depth test settle
     // a shared pixel differently, and at the frustum-edge crack skirts the tree adds.
@@ -298,7 +298,7 @@ struct Stack {
   std::array<double, 3> expected{};  // the sorted "over" composite at the centre, 0..255
 };
 
-Stack stack_of(int layers, double alpha, const app::Rgb& background, int width, int height) {
+Stack stack_of(int layers, double alpha, const app::scene::Rgb& background, int width, int height) {
   Stack s;
   s.camera = look_at({0.0, 0.0, 100.0}, {0.0, 0.0, 0.0}, width, height, 1.0, {0.0, 1.0, 0.0});
   static constexpr std::array<std::array<std::uint8_t, 3>, 8> kPalette{{{230, 40, 40},

@@ -1,7 +1,7 @@
 // The pieces of `terravol fly` output that need no renderer: frame names, resuming, the box
 // filter, the progress line, and the video sink's temporary file.
-#include "app/frame_sink.h"
-#include "app/png_output.h"
+#include "app/output/frame_sink.h"
+#include "app/output/png_output.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 
 #include "temp_dir.h"
 
-namespace terravol::app {
+namespace terravol::app::output {
 namespace {
 
 TEST(FrameSink, FrameNamesAreZeroPaddedAndSortInOrder) {
@@ -108,4 +108,4 @@ TEST(FrameSink, FinishedVideoReplacesOnlyWithOverwrite) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::output

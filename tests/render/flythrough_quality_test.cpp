@@ -10,15 +10,15 @@
 #include <cstdio>
 #include <vector>
 
-#include "app/camera.h"
-#include "app/terrain_colors.h"
-#include "app/terrain_renderer.h"
-#include "app/terrain_scene.h"
+#include "app/render/terrain_renderer.h"
+#include "app/scene/camera.h"
+#include "app/scene/terrain_colors.h"
+#include "app/scene/terrain_scene.h"
 #include "image_compare.h"
 #include "require_display.h"
 #include "shared_data.h"
 
-namespace terravol::app {
+namespace terravol::app::render {
 namespace {
 
 double psnr(const test::Image& a, const test::Image& b) {
@@ -42,11 +42,11 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
   TERRAVOL_REQUIRE_SHARED(dem);
   TERRAVOL_REQUIRE_DISPLAY();
   const io::Mosaic mosaic = io::Mosaic::open({dem});
-  const WindowChoice window = choose_window(mosaic.rows(), mosaic.cols(), 600.0, 600.0, 1024);
-  const TerrainScene scene(mosaic, window, default_levels(window.cells));
+  const scene::WindowChoice window = scene::choose_window(mosaic.rows(), mosaic.cols(), 600.0, 600.0, 1024);
+  const scene::TerrainScene scene(mosaic, window, scene::default_levels(window.cells));
   const mrbsp::TerrainTree& tree = scene.tree();
-  const TerrainShading lattice = shade_terrain(scene.cells(), scene.xs(), scene.ys(), scene.z(), scene.heights(), {});
-  const TerrainShading shading = vertex_shading(lattice, tree.merged_base(), tree.merged_colors());
+  const scene::TerrainShading lattice = scene::shade_terrain(scene.cells(), scene.xs(), scene.ys(), scene.z(), scene.heights(), {});
+  const scene::TerrainShading shading = scene::vertex_shading(lattice, tree.merged_base(), tree.merged_colors());
   RenderSettings settings;
   settings.gradient = false;  // one background colour for every view
   settings.haze_distance = 0.0;
@@ -58,7 +58,7 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
     // A path across the window: low oblique views (pitch -5 to -20 degrees, 600 to 2500 m above
     // the ground) turning through all headings, and a few high overviews.
     const double t = k / 23.0;
-    CameraPose pose;
+    scene::CameraPose pose;
     pose.lat = 44.25 + 0.5 * t;
     pose.lon = -71.75 + 0.5 * std::sin(3.0 * t);
     pose.heading_deg = 15.0 * k;
@@ -67,7 +67,7 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
     const double ground = scene.ground_height(pose.lat, pose.lon);
     const double clearance = overview ? 8000.0 : 600.0 + 1900.0 * std::abs(std::cos(1.3 * k));
     const mrbsp::Camera camera =
-        make_scene_camera(scene.frame(), pose, ground + clearance, 45.0, settings.width, settings.height, near_plane_for(clearance));
+        scene::make_scene_camera(scene.frame(), pose, ground + clearance, 45.0, settings.width, settings.height, scene::near_plane_for(clearance));
     renderer.set_camera(camera, 200000.0);
 
     mrbsp::TraversalOptions lod;
@@ -75,7 +75,7 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
     const double lod_triangles = static_cast<double>(frame.indices.size() / 3);
     renderer.set_frame(frame);
     renderer.render();
-    const test::Image lod_image = test::decode_png(renderer.png());
+    const test::Image lod_image = test::image_of_rgb(renderer.rgb(), settings.width, settings.height);
 
     mrbsp::TraversalOptions full;
     full.full_res = true;
@@ -83,7 +83,7 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
     const double full_triangles = static_cast<double>(frame.indices.size() / 3);
     renderer.set_frame(frame);
     renderer.render();
-    const test::Image full_image = test::decode_png(renderer.png());
+    const test::Image full_image = test::image_of_rgb(renderer.rgb(), settings.width, settings.height);
 
     ratios.push_back(full_triangles / lod_triangles);
     psnrs.push_back(psnr(lod_image, full_image));
@@ -97,4 +97,4 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::render

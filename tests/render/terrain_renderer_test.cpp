@@ -1,21 +1,21 @@
-// app/terrain_renderer.h and app/ordered_mapper.h on a tiny scene of their own: the draw order
+// app/render/terrain_renderer.h and app/render/ordered_mapper.h on a tiny scene of their own: the draw order
 // of the triangle list decides visibility under --order bsp, the depth buffer under zbuffer.
 #include <gtest/gtest.h>
 #include <vtkPolyData.h>
 
 #include <vector>
 
-#include "app/terrain_renderer.h"
+#include "app/render/terrain_renderer.h"
 #include "image_compare.h"
 #include "require_display.h"
 
-namespace terravol::app {
+namespace terravol::app::render {
 namespace {
 
 // Two unit-ish squares seen from above: a red one at z = 5 (near) and a blue one at z = 0 (far).
 struct TwoSquares {
   std::vector<glm::vec3> positions;
-  TerrainShading shading;
+  scene::TerrainShading shading;
   mrbsp::Camera camera;
 };
 
@@ -27,7 +27,7 @@ TwoSquares two_squares(std::uint8_t near_alpha) {
   for (int v = 0; v < 8; ++v) {
     s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
     s.shading.shade.push_back(1.0f);
-    s.shading.rgba.push_back(v < 4 ? Rgba{255, 0, 0, near_alpha} : Rgba{0, 0, 255, 255});
+    s.shading.rgba.push_back(v < 4 ? scene::Rgba{255, 0, 0, near_alpha} : scene::Rgba{0, 0, 255, 255});
   }
   s.camera.eye = {0.0, 0.0, 20.0};
   s.camera.forward = {0.0, 0.0, -1.0};
@@ -50,7 +50,7 @@ const std::vector<std::uint32_t> kNearThenFar{0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7
 const std::vector<std::uint32_t> kFarThenNear{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3};
 
 // 64 x 64 pixels on a uniform green background.
-RenderSettings two_squares_settings(DrawOrder order) {
+RenderSettings two_squares_settings(scene::DrawOrder order) {
   RenderSettings settings;
   settings.width = 64;
   settings.height = 64;
@@ -60,12 +60,12 @@ RenderSettings two_squares_settings(DrawOrder order) {
   return settings;
 }
 
-test::Rgb8 centre_pixel(const TwoSquares& s, DrawOrder order, const std::vector<std::uint32_t>& indices) {
+test::Rgb8 centre_pixel(const TwoSquares& s, scene::DrawOrder order, const std::vector<std::uint32_t>& indices) {
   TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(order));
   renderer.set_camera(s.camera, 100.0);
   renderer.set_frame(frame_of(indices));
   renderer.render();
-  const test::Image img = test::decode_png(renderer.png());
+  const test::Image img = test::image_of_rgb(renderer.rgb(), 64, 64);
   EXPECT_EQ(img.width, 64);
   return img.width == 64 ? img.at(32, 32) : test::Rgb8{};
 }
@@ -73,21 +73,21 @@ test::Rgb8 centre_pixel(const TwoSquares& s, DrawOrder order, const std::vector<
 TEST(TerrainRenderer, BspOrderDrawsLaterTrianglesOnTopWithoutDepthTest) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
-  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, kNearThenFar), (test::Rgb8{0, 0, 255})) << "the far square, drawn last";
-  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, kFarThenNear), (test::Rgb8{255, 0, 0}));
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, kNearThenFar), (test::Rgb8{0, 0, 255})) << "the far square, drawn last";
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, kFarThenNear), (test::Rgb8{255, 0, 0}));
 }
 
 TEST(TerrainRenderer, ZBufferOrderShowsTheNearestWhateverTheOrder) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
-  EXPECT_EQ(centre_pixel(s, DrawOrder::kZBuffer, kNearThenFar), (test::Rgb8{255, 0, 0}));
-  EXPECT_EQ(centre_pixel(s, DrawOrder::kZBuffer, kFarThenNear), (test::Rgb8{255, 0, 0}));
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kZBuffer, kNearThenFar), (test::Rgb8{255, 0, 0}));
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kZBuffer, kFarThenNear), (test::Rgb8{255, 0, 0}));
 }
 
 TEST(TerrainRenderer, BspOrderBlendsTranslucentTrianglesOverWhatIsBehind) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(128);  // the near red square half transparent
-  const test::Rgb8 c = centre_pixel(s, DrawOrder::kBsp, kFarThenNear);
+  const test::Rgb8 c = centre_pixel(s, scene::DrawOrder::kBsp, kFarThenNear);
   EXPECT_NEAR(c[0], 128, 2);
   EXPECT_EQ(c[1], 0);
   EXPECT_NEAR(c[2], 127, 2);
@@ -96,33 +96,33 @@ TEST(TerrainRenderer, BspOrderBlendsTranslucentTrianglesOverWhatIsBehind) {
 TEST(TerrainRenderer, EmptyFrameShowsTheBackground) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
-  EXPECT_EQ(centre_pixel(s, DrawOrder::kBsp, {}), (test::Rgb8{0, 255, 0}));
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, {}), (test::Rgb8{0, 255, 0}));
 }
 
 // A slide frees the renderer's vertices (and their GPU buffers) before the tree merges again,
 // then gives it the new ones, which may be more.
 TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven) {
   TERRAVOL_REQUIRE_DISPLAY();
-  for (DrawOrder order : {DrawOrder::kBsp, DrawOrder::kSort}) {
+  for (scene::DrawOrder order : {scene::DrawOrder::kBsp, scene::DrawOrder::kSort}) {
     TwoSquares s = two_squares(255);
     TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(order));
     renderer.set_camera(s.camera, 100.0);
     renderer.set_frame(frame_of(kFarThenNear));
     renderer.render();
-    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{255, 0, 0}));
+    EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32), (test::Rgb8{255, 0, 0}));
 
     renderer.release_vertices();
     EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 0);
     EXPECT_EQ(renderer.scene()->GetNumberOfCells(), 0);
     renderer.render();
-    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{0, 255, 0}));
+    EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32), (test::Rgb8{0, 255, 0}));
 
     // Four more vertices: a white square at z = 8, drawn last.
     for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
       s.positions.emplace_back(x, y, 8.0f);
       s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
       s.shading.shade.push_back(1.0f);
-      s.shading.rgba.push_back(Rgba{255, 255, 255, 255});
+      s.shading.rgba.push_back(scene::Rgba{255, 255, 255, 255});
     }
     renderer.replace_vertices(s.positions, s.shading);
     EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 12);
@@ -130,9 +130,9 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
     three.insert(three.end(), {8, 9, 10, 8, 10, 11});
     renderer.set_frame(frame_of(three));
     renderer.render();
-    EXPECT_EQ(test::decode_png(renderer.png()).at(32, 32), (test::Rgb8{255, 255, 255}));
+    EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32), (test::Rgb8{255, 255, 255}));
   }
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::render

@@ -1,6 +1,6 @@
 // Camera paths: the file format's errors, and the camera between keys (through the keys, C1,
 // no flip at north, constant speed on request).
-#include "app/camera_path.h"
+#include "app/scene/camera_path.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -12,7 +12,7 @@
 
 #include <glm/geometric.hpp>
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 using nlohmann::json;
@@ -349,4 +349,4 @@ TEST(CameraPath, FovBetweenKeysStaysWithinTheirRange) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,17 +1,14 @@
-// app/camera.h: the pose parser and the camera in the scene frame.
+// app/scene/camera.h: the pose parser and the camera in the scene frame.
 #include <gtest/gtest.h>
-
-#include <vtkCamera.h>
-#include <vtkNew.h>
 
 #include <cmath>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
 
-#include "app/camera.h"
+#include "app/scene/camera.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 TEST(CameraPose, ParsesFiveNumbers) {
@@ -85,21 +82,6 @@ TEST(SceneCamera, EyeDropsWithTheEarthsCurvatureLikeTheTerrain) {
   EXPECT_LT(c.eye.z, 1500.0 - 200.0) << "about 54 km from the origin the drop is about 230 m";
 }
 
-TEST(SceneCamera, VtkCameraGetsTheSameView) {
-  const io::SceneFrame frame(45.0, 6.0);
-  const auto c = make_scene_camera(frame, {45.1, 6.1, 0, 30, -10}, 2000.0, 40.0, 800, 600, 5.0);
-  vtkNew<vtkCamera> vc;
-  apply_camera(c, 50000.0, *vc);
-  const double* pos = vc->GetPosition();
-  const double* dir = vc->GetDirectionOfProjection();
-  EXPECT_NEAR(pos[2], c.eye.z, 1e-9);
-  EXPECT_NEAR(dir[0], c.forward.x, 1e-9);
-  EXPECT_NEAR(dir[2], c.forward.z, 1e-9);
-  EXPECT_DOUBLE_EQ(vc->GetViewAngle(), 40.0);
-  EXPECT_DOUBLE_EQ(vc->GetClippingRange()[0], 5.0);
-  EXPECT_DOUBLE_EQ(vc->GetClippingRange()[1], 50000.0);
-}
-
 TEST(SceneCamera, NearPlaneFollowsTheClearance) {
   EXPECT_DOUBLE_EQ(near_plane_for(100.0), 5.0);
   EXPECT_DOUBLE_EQ(near_plane_for(1.0), 0.5);
@@ -107,4 +89,4 @@ TEST(SceneCamera, NearPlaneFollowsTheClearance) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,12 +1,12 @@
-// app/flight.h: the viewer's flight controls, without a window.
+// app/scene/flight.h: the viewer's flight controls, without a window.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "app/flight.h"
+#include "app/scene/flight.h"
 #include "io/scene_frame.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
@@ -115,4 +115,4 @@ TEST(Flight, MouseDragRightTurnsRightAndUpLooksUp) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

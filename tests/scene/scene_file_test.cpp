@@ -6,10 +6,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/scene_file.h"
+#include "app/scene/scene_file.h"
 #include "temp_dir.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 using nlohmann::json;
@@ -117,4 +117,4 @@ TEST(SceneFile, FilesThatAreNotScenesFailWithOneLine) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

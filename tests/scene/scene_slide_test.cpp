@@ -1,12 +1,12 @@
-// Sliding the terrain window (app/terrain_scene.h: plan_slide, TerrainScene::slide).
+// Sliding the terrain window (app/scene/terrain_scene.h: plan_slide, TerrainScene::slide).
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "app/terrain_scene.h"
+#include "app/scene/terrain_scene.h"
 #include "io/mosaic.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 const WindowChoice kWindow{400, 300, 256};  // rows 400..656, columns 300..556
@@ -91,4 +91,4 @@ TEST(TerrainSceneSlide, RefusesAnotherSize) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

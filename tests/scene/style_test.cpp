@@ -1,11 +1,12 @@
-// app/render_options.h: the compound option values of `terravol render`.
+// app/scene/style.h: the compound option values, and which source of a value wins.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
-#include "app/render_options.h"
+#include "app/scene/scene_file.h"
+#include "app/scene/style.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 TEST(RenderOptions, SizeIsWidthByHeight) {
@@ -59,4 +60,4 @@ TEST(RenderOptions, CameraComesFromTheOptionElseTheSceneFileWithItsAglAndFov) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

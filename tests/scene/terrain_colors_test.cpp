@@ -1,11 +1,11 @@
-// app/terrain_colors.h: tint, hillshade, water, skirts, LOD colours and the sky.
+// app/scene/terrain_colors.h: tint, hillshade, water, skirts, LOD colours and the sky.
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "app/terrain_colors.h"
+#include "app/scene/terrain_colors.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 struct Lattice {
@@ -85,4 +85,4 @@ TEST(TerrainColors, SkyIsHazeAtTheHorizonAndBluerAbove) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -1,11 +1,11 @@
-// app/terrain_scene.h: the window around the camera and the default level count.
+// app/scene/terrain_scene.h: the window around the camera and the default level count.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
-#include "app/terrain_scene.h"
+#include "app/scene/terrain_scene.h"
 
-namespace terravol::app {
+namespace terravol::app::scene {
 namespace {
 
 TEST(ChooseWindow, LargestPowerOfTwoThatFitsCappedByTheOption) {
@@ -40,4 +40,4 @@ TEST(DefaultLevels, CoarsestLevelIsEightCellsSquare) {
 }
 
 }  // namespace
-}  // namespace terravol::app
+}  // namespace terravol::app::scene

@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "app/camera_path.h"
+#include "app/scene/camera_path.h"
 #include "image_compare.h"
 #include "require_display.h"
 #include "run_command.h"
@@ -620,7 +620,7 @@ TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
   v.tap("j");
   const json s = v.settle();
   EXPECT_NE(s["message"].get<std::string>().find("saved 2 keyframes"), std::string::npos) << s["message"];
-  const app::CameraPathFile loaded = app::load_camera_path(path);
+  const app::scene::CameraPathFile loaded = app::scene::load_camera_path(path);
   ASSERT_EQ(loaded.keys.size(), 2u);
   EXPECT_DOUBLE_EQ(loaded.keys[0].heading_deg, 0.0);
   EXPECT_NEAR(loaded.keys[1].heading_deg, before["camera"]["heading"].get<double>(), 1e-9);

@@ -1,0 +1,126 @@
+#include "app/cli/scene_options.h"
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "volume/geometry.h"
+#include "volume/volume.h"
+
+namespace terravol::app::cli {
+
+void add_scene_options(CLI::App& cmd, SceneArgs& args) {
+  cmd.add_option("--scene", args.scene,
+                 "Scene file (JSON: dem, volumes, camera, render; docs/scene-file.md); options given here override it");
+  cmd.add_option("--volume", args.volumes, "RF volume (.vdb, .vti, .vtk) to draw over the terrain; repeatable");
+  cmd.add_option("--field", args.field, "The --volume files' grid or array (default: the first)");
+  cmd.add_option("--volume-frame", args.volume_frame,
+                 "Where the --volume files lie when they do not say: geographic, geographic-agl or enu:LAT,LON,H");
+  cmd.add_option("--iso", args.isos,
+                 "Isosurface VALUE[,color=R:G:B][,opacity=A] of every --volume (of the scene file's volumes when "
+                 "no --volume is given); repeatable");
+  cmd.add_option("--slice", args.slices,
+                 "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
+                 "repeatable");
+  cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
+
+  StyleArgs& s = args.style;
+  const scene::Style defaults;
+  s.size = std::to_string(defaults.width) + "x" + std::to_string(defaults.height);
+  s.metric = scene::metric_name(defaults.traversal.metric);
+  s.order = scene::order_name(defaults.order);
+  s.tint = scene::tint_name(defaults.shading.tint);
+  s.window = defaults.window;
+  s.haze_km = defaults.haze_km;
+  s.sun_azimuth = defaults.shading.sun_azimuth_deg;
+  s.sun_elevation = defaults.shading.sun_elevation_deg;
+  s.surface_triangles = defaults.surface_triangles;
+  s.size_option = cmd.add_option("--size", s.size, "Image (view: window) size WIDTHxHEIGHT, pixels")->capture_default_str();
+  s.metric_option = cmd.add_option("--lod-metric", s.metric,
+                                   "LOD metric: error (screen-space error) or area (the paper's); in view, key M switches")
+                        ->capture_default_str();
+  s.threshold_option = cmd.add_option("--threshold", s.threshold,
+                                      "LOD threshold: pixels of screen-space error (default 2) or, with --lod-metric "
+                                      "area, projected box area in square pixels (default 500)");
+  s.window_option = cmd.add_option("--window", s.window, "Largest window side, cells (a power of two)")->capture_default_str();
+  s.order_option = cmd.add_option("--order", s.order,
+                                  "bsp (tree order, no depth test), zbuffer (the same order, depth-tested), and for "
+                                  "translucent volumes the references: peel (VTK depth peeling, unlimited peels: "
+                                  "exact), vtk (VTK's default alpha blending, unsorted), sort (vtkDepthSortPolyData)")
+                       ->capture_default_str();
+  s.sun_azimuth_option = cmd.add_option("--sun-azimuth", s.sun_azimuth, "Sun direction, degrees clockwise from north")
+                             ->capture_default_str();
+  s.sun_elevation_option = cmd.add_option("--sun-elevation", s.sun_elevation, "Sun elevation, degrees")->capture_default_str();
+  s.haze_option = cmd.add_option("--haze", s.haze_km,
+                                 "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; 0: none")
+                      ->capture_default_str();
+  s.tint_option = cmd.add_option("--tint", s.tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
+                      ->capture_default_str();
+  s.surface_option = cmd.add_option("--surface-triangles", s.surface_triangles,
+                                    "Decimate each isosurface and slice to at most this many triangles before merging "
+                                    "(0: keep all)")
+                         ->capture_default_str();
+}
+
+scene::SceneStyle given_style(const SceneArgs& args) {
+  const StyleArgs& s = args.style;
+  const auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
+  scene::SceneStyle g;
+  if (given(s.size_option)) {
+    int w = 0, h = 0;
+    scene::parse_size(s.size, w, h);
+    g.width = w;
+    g.height = h;
+  }
+  if (given(s.metric_option)) g.lod_metric = s.metric;
+  if (given(s.threshold_option)) g.threshold = s.threshold;
+  if (given(s.order_option)) g.order = s.order;
+  if (given(s.tint_option)) g.tint = s.tint;
+  if (given(s.window_option)) g.window = s.window;
+  if (given(s.haze_option)) g.haze_km = s.haze_km;
+  if (given(s.sun_azimuth_option)) g.sun_azimuth = s.sun_azimuth;
+  if (given(s.sun_elevation_option)) g.sun_elevation = s.sun_elevation;
+  if (given(s.surface_option)) g.surface_triangles = s.surface_triangles;
+  if (args.no_legend) g.legend = false;
+  return g;
+}
+
+scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems) {
+  scene::SceneSpec scene;
+  if (!args.scene.empty()) scene = scene::load_scene_file(args.scene);
+  if (dems.empty()) dems = scene.dems;
+  if (dems.empty()) throw std::invalid_argument("no DEM: give DEM files or a scene file with \"dem\"");
+  scene.dems = dems;
+  scene.style = scene::overlay(scene.style, given_style(args));
+  const std::string& frame = args.volume_frame;
+  if (!frame.empty()) {
+    try {
+      volume::parse_frame(frame);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--volume-frame " + frame + ": " + e.what());
+    }
+  }
+  std::vector<volume::IsoSpec> iso_specs;
+  for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
+  std::vector<volume::SliceSpec> slice_specs;
+  for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
+  if (args.volumes.empty()) {
+    for (scene::VolumeSpec& v : scene.volumes) {
+      if (!iso_specs.empty()) v.isosurfaces = iso_specs;
+      if (!slice_specs.empty()) v.slices = slice_specs;
+    }
+    return scene;
+  }
+  for (const auto& f : args.volumes) {
+    scene::VolumeSpec v;
+    v.file = f;
+    v.field = args.field;
+    v.frame = frame;
+    v.isosurfaces = iso_specs;
+    v.slices = slice_specs;
+    scene.volumes.push_back(std::move(v));
+  }
+  return scene;
+}
+
+}  // namespace terravol::app::cli

@@ -1,0 +1,56 @@
+// The options of the commands that read a scene (render, view): --scene and the volumes, and
+// one option per key of the scene file's "render" object, which overrides that key
+// (scene::overlay, app/scene/style.h). The parsers behind them are in app/scene/style.h.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "app/scene/scene_file.h"
+#include "app/scene/style.h"
+
+namespace terravol::app::cli {
+
+// The style options as given: --size, --lod-metric, --threshold, --order, --tint, --window,
+// --haze, --sun-azimuth, --sun-elevation, --surface-triangles. The values start at
+// scene::Style's defaults (shown in --help); only the options given count (given_style).
+struct StyleArgs {
+  std::string size, metric, order, tint;
+  double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0;
+  int window = 0;
+  std::size_t surface_triangles = 0;
+  CLI::Option *size_option = nullptr, *metric_option = nullptr, *threshold_option = nullptr,
+              *order_option = nullptr, *tint_option = nullptr, *window_option = nullptr, *haze_option = nullptr,
+              *sun_azimuth_option = nullptr, *sun_elevation_option = nullptr, *surface_option = nullptr;
+};
+
+// The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --no-legend
+// and the style options.
+struct SceneArgs {
+  std::filesystem::path scene;
+  std::vector<std::filesystem::path> volumes;
+  std::vector<std::string> isos, slices;
+  std::string volume_frame, field;
+  bool no_legend = false;
+  StyleArgs style;
+};
+void add_scene_options(CLI::App& cmd, SceneArgs& args);
+
+// The style keys the command line gave: each style option given, and legend false with
+// --no-legend. Throws std::invalid_argument for a bad --size.
+scene::SceneStyle given_style(const SceneArgs& args);
+
+// The scene the command line describes: the --scene file (empty without one), its DEMs
+// replaced by `dems` when not empty (else `dems` gets the file's; none at all is an error),
+// its style overlaid with given_style (the options win), and its volumes joined with the
+// --volume files: each --volume FILE (read as --field, placed by --volume-frame) gets the
+// --iso and --slice styles; with no --volume, non-empty --iso or --slice lists replace the
+// styles of every volume of the file. Throws std::invalid_argument for a bad file or bad
+// --iso, --slice, --volume-frame or --size text.
+scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
+
+}  // namespace terravol::app::cli
