@@ -33,6 +33,14 @@ app::render::RenderSettings plain_settings(const BenchConfig& c) {
   return s;
 }
 
+// The pipeline's options for a benchmark's scene: no legend, windows of at most `max_window` cells.
+app::render::SceneOptions bench_scene_options(int max_window = 1024) {
+  app::render::SceneOptions o;
+  o.max_window = max_window;
+  o.legend = false;
+  return o;
+}
+
 // The scene of a terrain with its window centred on (lat, lon) (the mosaic's centre when both
 // are NaN) at most `max_window` cells wide.
 app::scene::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double lon = std::nan("")) {
@@ -82,7 +90,7 @@ double far_plane(const app::render::SceneRenderer& scene) { return scene.terrain
 
 json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
   say(c, "terrain " + terrain.name + ": building the 1024-cell window");
-  app::render::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), 1024, 0, {}, false);
+  app::render::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), bench_scene_options());
   auto plain = plain_scene(scene, {}, Translucency::kPeel4, c);
   const std::vector<View> views = flythrough(scene.terrain().bounds(), c.views);
 
@@ -180,7 +188,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   app::scene::SceneSpec spec = vs.spec;
   spec.camera = terrain_spec(terrain, vs.lat, vs.lon).camera;  // the window centred on the volumes
   say(c, "translucency " + terrain.name + ": reading the volumes and merging them into the tree");
-  app::render::SceneRenderer scene(spec, plain_settings(c), 1024, 0, {}, false);
+  app::render::SceneRenderer scene(spec, plain_settings(c), bench_scene_options());
   const app::scene::MergeFigures merged = scene.merge_figures();
   const mrbsp::MemoryStats memory = scene.terrain().tree().memory();
 
@@ -331,7 +339,7 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
     const Terrain& t = terrains[k];
     say(c, "scaling " + t.name + ": building its largest window");
     const auto t0 = Clock::now();
-    app::render::SceneRenderer scene(terrain_spec(t), plain_settings(c), 4096, 0, {}, false);
+    app::render::SceneRenderer scene(terrain_spec(t), plain_settings(c), bench_scene_options(4096));
     const double build_ms = ms_since(t0);
     const app::scene::WindowBounds b = scene.terrain().bounds();
     View view;

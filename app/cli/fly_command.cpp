@@ -17,15 +17,16 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "app/cli/commands.h"
 #include "app/output/frame_sink.h"
 #include "app/output/write_file.h"
 #include "app/render/scene_renderer.h"
 #include "app/scene/camera_path.h"
+#include "app/scene/mosaic_lattice.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
-#include "app/scene/terrain_scene.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::cli {
@@ -70,13 +71,7 @@ std::uint64_t file_hash(const std::filesystem::path& p) {
   return h;
 }
 
-// The lattice row and column of a point, and whether it lies inside the mosaic.
-bool inside(const io::Mosaic& m, double lat, double lon, double& row, double& col) {
-  const io::Georef& g = m.georef();
-  row = (g.y0 - lat) / g.dy;
-  col = (std::remainder(lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-  return row >= 0 && row <= m.rows() - 1 && col >= 0 && col <= m.cols() - 1;
-}
+bool inside(const io::Mosaic& m, double lat, double lon) { return scene::inside(m, scene::lattice_point(m, lat, lon)); }
 
 // The keys around time t, for messages: "keys[2] and keys[3]" or "keys[2]".
 std::string keys_around(const std::vector<scene::PathKey>& keys, double t) {
@@ -213,20 +208,14 @@ void run_fly(const FlyOptions& o) {
   // The scene: its first window around the path's first key.
   const scene::PathKey& k0 = file.keys.front();
   scene.camera = scene::SceneCamera{scene::CameraPose{k0.lat, k0.lon, k0.alt, 0.0, 0.0}, k0.agl, default_fov};
-  const io::Mosaic mosaic = io::Mosaic::open(scene.dems);
-  double row = 0, col = 0;
-  if (!inside(mosaic, k0.lat, k0.lon, row, col)) {
+  io::Mosaic mosaic = io::Mosaic::open(scene.dems);
+  if (!inside(mosaic, k0.lat, k0.lon)) {
     throw std::invalid_argument(source + ": keys[0]: " + fixed(k0.lat, 5) + ", " + fixed(k0.lon, 5) + " is outside the DEM");
   }
-  render::RenderSettings settings;
+  render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
   settings.height = height * factor;
-  settings.order = st.order;
-  settings.gradient = true;
-  settings.haze_color = scene::kHorizon;
-  settings.haze_distance = st.haze_km * 1000.0;
-  settings.offscreen = true;
-  render::SceneRenderer renderer(scene, settings, st.window, 0, st.shading, st.legend, st.surface_triangles);
+  render::SceneRenderer renderer(std::move(mosaic), scene, settings, render::scene_options(st));
 
   const scene::CameraPath path(file.keys, renderer.frame(),
                         [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); }, file.speed,
@@ -239,7 +228,7 @@ void run_fly(const FlyOptions& o) {
     const scene::PathSample s = path.at(t);
     const std::string when = source + ": at t=" + fixed(t, 2) + " s (frame " + std::to_string(k) + ", " +
                              keys_around(file.keys, t) + ")";
-    if (!inside(mosaic, s.pose.lat, s.pose.lon, row, col)) {
+    if (!inside(renderer.mosaic(), s.pose.lat, s.pose.lon)) {
       throw std::invalid_argument(when + " the camera (" + fixed(s.pose.lat, 5) + ", " + fixed(s.pose.lon, 5) +
                                   ") is outside the DEM");
     }
@@ -253,20 +242,7 @@ void run_fly(const FlyOptions& o) {
 
   // Frames before `from` are not drawn, but the window slides they would have made are made,
   // so that the window (and so every pixel) at `from` is that of an uninterrupted run.
-  {
-    scene::WindowChoice w = renderer.terrain().window();
-    const int step = 1 << (renderer.terrain().tree().levels() - 1);
-    for (long k = 0; k < from; ++k) {
-      const scene::PathSample s = path.at(time_of(k));
-      inside(mosaic, s.pose.lat, s.pose.lon, row, col);
-      const scene::WindowChoice next = scene::plan_slide(w, mosaic.rows(), mosaic.cols(), row, col, step);
-      if (next.row0 == w.row0 && next.col0 == w.col0) continue;
-      mrbsp::TraversalOptions tr = traversal;
-      tr.threshold_px = static_cast<float>(s.threshold * threshold_scale);
-      renderer.render(s.pose, path.agl(), s.fov_y_deg, tr);
-      w = renderer.terrain().window();
-    }
-  }
+  for (long k = 0; k < from; ++k) renderer.slide_for(path.at(time_of(k)).pose);
 
   // Outputs.
   std::unique_ptr<output::FrameSink> sink;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -45,7 +46,8 @@ struct RenderOptions {
   std::filesystem::path output;    // PNG
   double fov_y_deg = 45.0;         // vertical, (0, 180)
   scene::Style style;              // the scene file's, overridden by the style options
-  render::RenderSettings render;   // wireframe, lod colours, background; the rest from style
+  bool wireframe = false, lod_colors = false;
+  std::optional<scene::Rgb> background;  // uniform, instead of the sky
   bool full_res = false;           // every region at full resolution
   int levels = 0;                  // 0: default_levels(window)
   bool force = false;              // replace existing outputs
@@ -63,10 +65,13 @@ void run_render(const RenderOptions& o) {
   }
   const auto t_start = Clock::now();
   const scene::Style& st = o.style;
-  render::RenderSettings settings = o.render;
-  settings.width = st.width;
-  settings.height = st.height;
-  settings.order = st.order;
+  render::RenderSettings settings = render::render_settings(st);
+  settings.wireframe = o.wireframe;
+  settings.lod_colors = o.lod_colors;
+  if (o.background) {
+    settings.background = *o.background;
+    settings.gradient = false;
+  }
   if (settings.gradient) {
     const auto sky = scene::sky_gradient(o.pose.pitch_deg, o.fov_y_deg);
     settings.background = sky[0];
@@ -86,7 +91,7 @@ void run_render(const RenderOptions& o) {
   scene.volumes = o.volumes;
   scene.camera = scene::SceneCamera{o.pose, o.agl, o.fov_y_deg};
   const auto t_scene = Clock::now();
-  render::SceneRenderer view(scene, settings, st.window, o.levels, st.shading, st.legend, st.surface_triangles);
+  render::SceneRenderer view(scene, settings, render::scene_options(st, o.levels));
   const double scene_ms = ms_since(t_scene);
 
   // Two frames: the first pays for the upload of the vertices and the shaders; the second is
@@ -183,8 +188,8 @@ void add_render_command(CLI::App& app) {
   auto* fov = cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
   cmd->add_option("--background", raw->background, "Uniform background R,G,B (0-255) instead of the sky");
-  cmd->add_flag("--wireframe", o.render.wireframe, "Draw triangle edges only");
-  cmd->add_flag("--lod-colors", o.render.lod_colors, "Colour each LOD level (skirts grey)");
+  cmd->add_flag("--wireframe", o.wireframe, "Draw triangle edges only");
+  cmd->add_flag("--lod-colors", o.lod_colors, "Colour each LOD level (skirts grey)");
   cmd->add_flag("--full-res", o.full_res, "Every region at full resolution");
   cmd->add_flag("--agl", o.agl, "ALT is metres above the ground under the camera");
   cmd->add_flag("--force", o.force, "Replace existing output files");
@@ -200,10 +205,7 @@ void add_render_command(CLI::App& app) {
     opt.pose = *pose;
     opt.style = scene::resolve_style(file.style);
     opt.volumes = file.volumes;
-    if (!raw->background.empty()) {
-      opt.render.background = scene::parse_rgb("--background", raw->background);
-      opt.render.gradient = false;
-    }
+    if (!raw->background.empty()) opt.background = scene::parse_rgb("--background", raw->background);
     scene::check_view_options(opt.fov_y_deg, opt.style, levels->count() > 0, opt.levels);
     run_render(opt);
   });

@@ -1,26 +1,30 @@
 #include "app/render/scene_renderer.h"
 
+#include <vtkRenderWindow.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
 #include "app/scene/ground_grid.h"
+#include "app/scene/mosaic_lattice.h"
+#include "app/scene/timing.h"
+#include "io/error.h"
 
 namespace terravol::app::render {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using scene::Clock;
+using scene::ms_between;
+using scene::ms_since;
 
 // Gives the pages of freed heap memory back to the system (glibc; elsewhere nothing). The
 // merge of a slide frees its scratch (about a million small polygon lists and the vertices in
@@ -35,103 +39,197 @@ void return_freed_memory() {
 #endif
 }
 
-std::string degrees(double v, char positive, char negative) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4f %c", std::abs(v), v < 0 ? negative : positive);
-  return b;
-}
-
 }  // namespace
 
-SceneRenderer::SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, int max_window, int levels,
-                             const scene::ShadingOptions& shading, bool legend, std::size_t surface_triangles)
-    : mosaic_(io::Mosaic::open(scene.dems)), settings_(settings), shading_(shading), legend_(legend) {
-  const io::Georef& g = mosaic_.georef();
-  double row = (mosaic_.rows() - 1) / 2.0, col = (mosaic_.cols() - 1) / 2.0;
-  if (scene.camera) check_inside(scene.camera->pose);
+SceneOptions scene_options(const scene::Style& style, int levels, Sliding sliding) {
+  SceneOptions o;
+  o.max_window = style.window;
+  o.levels = levels;
+  o.shading = style.shading;
+  o.legend = style.legend;
+  o.surface_triangles = style.surface_triangles;
+  o.sliding = sliding;
+  return o;
+}
+
+RenderSettings render_settings(const scene::Style& style) {
+  RenderSettings s;
+  s.width = style.width;
+  s.height = style.height;
+  s.order = style.order;
+  s.gradient = true;
+  s.haze_color = scene::kHorizon;
+  s.haze_distance = style.haze_km * 1000.0;
+  return s;
+}
+
+SceneRenderer::SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, const SceneOptions& options)
+    : SceneRenderer(io::Mosaic::open(scene.dems), scene, settings, options) {}
+
+SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
+                             const SceneOptions& options)
+    : mosaic_(std::move(mosaic)), settings_(settings), options_(options) {
+  const scene::CameraPose at = scene.camera ? scene.camera->pose : scene::default_pose(mosaic_);
+  scene::require_inside(mosaic_, at.lat, at.lon);
   require_x_display();
-  if (scene.camera) {
-    row = (g.y0 - scene.camera->pose.lat) / g.dy;
-    col = (std::remainder(scene.camera->pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-  }
-  const scene::WindowChoice window = scene::choose_window(mosaic_.rows(), mosaic_.cols(), row, col, max_window);
-  levels_ = levels > 0 ? levels : scene::default_levels(window.cells);
+  const scene::LatticePoint p = scene::lattice_point(mosaic_, at.lat, at.lon);
+  const scene::WindowChoice window =
+      scene::choose_window(mosaic_.rows(), mosaic_.cols(), p.row, p.col, options_.max_window);
+  levels_ = options_.levels > 0 ? options_.levels : scene::default_levels(window.cells);
   scene_ = std::make_unique<scene::TerrainScene>(mosaic_, window, levels_);
 
   // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
-  volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), surface_triangles);
+  volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), options_.surface_triangles);
   volumes_.merge_into(*scene_);
-  lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
-  const scene::TerrainShading shading_all =
-      scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
-  renderer_ = std::make_unique<TerrainRenderer>(scene_->tree().positions(), shading_all, settings_,
-                                                ColorTexture{scene_->cells() + 1, lattice_.rgba});
-  if (legend_) renderer_->set_legend(volumes_.legend());
+  lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
+                                  options_.shading);
+  const mrbsp::TerrainTree& tree = scene_->tree();
+  renderer_ = std::make_unique<TerrainRenderer>(
+      tree.positions(), scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()), settings_,
+      ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  if (options_.legend) renderer_->set_legend(volumes_.legend());
 }
 
 SceneRenderer::~SceneRenderer() = default;
 
-void SceneRenderer::check_inside(const scene::CameraPose& pose) const {
-  const io::Georef& g = mosaic_.georef();
-  const double row = (g.y0 - pose.lat) / g.dy;
-  const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-  if (row < 0 || row > mosaic_.rows() - 1 || col < 0 || col > mosaic_.cols() - 1) {
-    const double south = g.y0 - (mosaic_.rows() - 1) * g.dy, east = g.x0 + (mosaic_.cols() - 1) * g.dx;
-    throw std::runtime_error("camera " + degrees(pose.lat, 'N', 'S') + ", " + degrees(pose.lon, 'E', 'W') +
-                             " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
-                             ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
-  }
-}
-
 void SceneRenderer::upload_vertices() {
-  const scene::TerrainShading all = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
-  renderer_->replace_vertices(scene_->tree().positions(), all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  const mrbsp::TerrainTree& tree = scene_->tree();
+  const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
+  renderer_->replace_vertices(tree.positions(), all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
-FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double fov_y_deg,
-                                 const mrbsp::TraversalOptions& traversal) {
-  check_inside(pose);
-  FrameStats stats;
-  // Slide when the camera nears the window's edge, by whole coarsest-level cells.
-  const io::Georef& g = mosaic_.georef();
-  const double row = (g.y0 - pose.lat) / g.dy;
-  const double col = (std::remainder(pose.lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-  const int step = 1 << (levels_ - 1);
-  const scene::WindowChoice next = scene::plan_slide(scene_->window(), mosaic_.rows(), mosaic_.cols(), row, col, step);
-  if (next.row0 != scene_->window().row0 || next.col0 != scene_->window().col0) {
-    const auto t0 = Clock::now();
-    // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
-    // tree slides and merges again, so the merge's scratch does not come on top of them.
-    renderer_->release_vertices();
-    try {
-      scene_->slide(mosaic_, next);  // merges the volumes' polygons again into the moved window
-    } catch (...) {
-      upload_vertices();  // the scene kept its window
-      throw;
-    }
-    return_freed_memory();  // the old vertices and the merge's scratch
-    lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), shading_);
-    upload_vertices();
-    return_freed_memory();  // the upload's shading copies
-    ++slides_;
-    stats.slide_ms = ms_since(t0);
-  }
-  stats.slides = slides_;
+namespace {
 
-  stats.ground_height = ground_height(pose.lat, pose.lon);
-  stats.eye_height = agl ? stats.ground_height + pose.alt : pose.alt;
-  const double clearance = stats.eye_height - stats.ground_height;
-  if (!(clearance > 0.0)) {
+// The eye's height in the datum over ground `ground`; throws when it is not above it.
+double eye_above(double ground, const scene::CameraPose& pose, bool agl) {
+  const double eye = agl ? ground + pose.alt : pose.alt;
+  if (!(eye - ground > 0.0)) {
     char b[160];
-    std::snprintf(b, sizeof b, "camera at %.1f m is not above the ground (%.1f m there)%s", stats.eye_height,
-                  stats.ground_height, agl ? "" : "; use --agl for heights above ground");
+    std::snprintf(b, sizeof b, "camera at %.1f m is not above the ground (%.1f m there)%s", eye, ground,
+                  agl ? "" : "; use --agl for heights above ground");
     throw std::runtime_error(b);
   }
-  const RenderSettings& s = renderer_->settings();
-  camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, s.width, s.height,
-                              scene::near_plane_for(clearance));
+  return eye;
+}
+
+}  // namespace
+
+double SceneRenderer::eye_height(const scene::CameraPose& pose, bool agl) const {
+  return eye_above(ground_height(pose.lat, pose.lon), pose, agl);
+}
+
+// Sliding (section 4.3), the same steps in both modes: next_window() decides, prepare_slide()
+// reads the moved window and shades it (on this thread, or on a worker with kAsynchronous),
+// finish_slide() slides the tree and replaces the renderer's vertices on this thread.
+std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::CameraPose& pose) const {
+  const scene::LatticePoint p = scene::lattice_point(mosaic_, pose.lat, pose.lon);
+  const scene::WindowChoice& now = scene_->window();
+  const int step = 1 << (levels_ - 1);  // samples across one coarsest-level cell
+  const scene::WindowChoice next = scene::plan_slide(now, mosaic_.rows(), mosaic_.cols(), p.row, p.col, step);
+  if (next.row0 == now.row0 && next.col0 == now.col0) return std::nullopt;
+  return next;
+}
+
+// Reads `next` from the mosaic (under its lock) in `frame` and shades it; with
+// terrain_vertices > 0 (a tree without merged polygons, whose vertices are the lattice's and the
+// skirts'), also the vertices' shading. Touches nothing of the pipeline, so it may run on a
+// worker thread while the pipeline draws.
+SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
+                                                          const scene::WindowChoice& next, const io::SceneFrame& frame,
+                                                          const scene::ShadingOptions& shading,
+                                                          std::size_t terrain_vertices) {
+  PreparedSlide p;
+  const auto t0 = Clock::now();
+  {
+    const std::lock_guard<std::mutex> lock(mosaic_mutex);
+    p.window = scene::read_scene_window(mosaic, next, frame);
+  }
+  const auto t1 = Clock::now();
+  p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, shading);
+  if (terrain_vertices > 0) p.vertices = scene::vertex_shading(p.lattice, terrain_vertices, {});
+  p.read_ms = ms_between(t0, t1);
+  p.shade_ms = ms_since(t1);
+  return p;
+}
+
+void SceneRenderer::finish_slide(PreparedSlide&& p) {
+  const auto t0 = Clock::now();
+  // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
+  // tree slides and merges again, so the merge's scratch does not come on top of them.
+  renderer_->release_vertices();
+  try {
+    scene_->slide(std::move(p.window));  // merges the volumes' polygons again into the moved window
+  } catch (...) {
+    upload_vertices();  // the scene kept its window
+    throw;
+  }
+  return_freed_memory();  // the old vertices and the merge's scratch
+  lattice_ = std::move(p.lattice);
+  const auto t1 = Clock::now();
+  const mrbsp::TerrainTree& tree = scene_->tree();
+  if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
+  renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  p.vertices = {};
+  return_freed_memory();  // the upload's shading copies
+  last_slide_ = {p.read_ms, p.shade_ms, ms_between(t0, t1), ms_since(t1)};
+  ++slides_;
+}
+
+bool SceneRenderer::slide_ready() const {
+  return pending_.valid() && pending_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+
+std::optional<std::string> SceneRenderer::take_slide_error() { return std::exchange(slide_error_, std::nullopt); }
+
+void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
+  const auto t0 = Clock::now();
+  bool slid = false;
+  // Without volumes the tree has no merged vertices, before the slide or after it: the
+  // vertices' shading can be made with the lattice's.
+  const std::size_t terrain_vertices = volumes_.size() == 0 ? scene_->tree().merged_base() : 0;
+  if (options_.sliding == Sliding::kSynchronous) {
+    if (const auto next = auto_slide_ ? next_window(pose) : std::nullopt) {
+      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame(), options_.shading, terrain_vertices));
+      slid = true;
+    }
+  } else {
+    if (slide_ready()) {
+      try {
+        PreparedSlide p = pending_.get();
+        finish_slide(std::move(p));
+        slid = true;
+      } catch (const io::FormatError& e) {
+        slide_error_ = e.what();
+        auto_slide_ = false;
+      }
+    }
+    if (auto_slide_ && !pending_.valid()) {
+      if (const auto next = next_window(pose)) {
+        pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
+                                                   shading = options_.shading, terrain_vertices] {
+          return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
+        });
+      }
+    }
+  }
+  if (slid) stats.slide_ms = ms_since(t0);
+  stats.slides = slides_;
+}
+
+FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, double fov_y_deg,
+                                  const mrbsp::TraversalOptions& traversal) {
+  scene::require_inside(mosaic_, pose.lat, pose.lon);
+  FrameStats stats;
+  slide(pose, stats);
+
+  stats.ground_height = ground_height(pose.lat, pose.lon);
+  stats.eye_height = eye_above(stats.ground_height, pose, agl);
+  const double clearance = stats.eye_height - stats.ground_height;
+  const int* size = renderer_->window()->GetSize();
+  camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, std::max(size[0], 1),
+                                     std::max(size[1], 1), scene::near_plane_for(clearance));
   renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
-  if (s.gradient) {
+  if (renderer_->settings().gradient) {
     const auto sky = scene::sky_gradient(pose.pitch_deg, fov_y_deg);
     renderer_->set_background(sky[0], sky[1]);
   }
@@ -142,7 +240,6 @@ FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double
   t0 = Clock::now();
   renderer_->set_frame(frame_);
   stats.upload_ms = ms_since(t0);
-  stats.draw_ms = renderer_->render();
   stats.triangles = frame_.indices.size() / 3;
   stats.merged_triangles = static_cast<std::size_t>(
       std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kMergedLevel)));
@@ -150,15 +247,34 @@ FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double
   return stats;
 }
 
+double SceneRenderer::draw() { return renderer_->render(); }
+
+bool SceneRenderer::slide_for(const scene::CameraPose& pose) {
+  scene::require_inside(mosaic_, pose.lat, pose.lon);
+  const int before = slides_;
+  FrameStats stats;
+  slide(pose, stats);
+  return slides_ > before;
+}
+
+FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double fov_y_deg,
+                                 const mrbsp::TraversalOptions& traversal) {
+  FrameStats stats = prepare(pose, agl, fov_y_deg, traversal);
+  stats.draw_ms = draw();
+  return stats;
+}
+
 std::unique_ptr<TerrainRenderer> SceneRenderer::make_renderer(const RenderSettings& settings) const {
-  const scene::TerrainShading all = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
-  return std::make_unique<TerrainRenderer>(scene_->tree().positions(), all, settings,
+  const mrbsp::TerrainTree& tree = scene_->tree();
+  const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
+  return std::make_unique<TerrainRenderer>(tree.positions(), all, settings,
                                            ColorTexture{scene_->cells() + 1, lattice_.rgba});
 }
 
 const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
   upload_vertices();
+  if (options_.legend) renderer_->set_legend(volumes_.legend());
   return volumes_.figures();
 }
 
@@ -168,6 +284,7 @@ double SceneRenderer::ground_height(double lat, double lon) const {
   const scene::WindowBounds b = scene_->bounds();
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
   const io::Georef& g = mosaic_.georef();
+  const std::lock_guard<std::mutex> lock(mosaic_mutex_);
   return scene::GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
 }
 

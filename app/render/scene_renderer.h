@@ -1,19 +1,25 @@
-// A whole scene drawn frame after frame: the DEM mosaic's window and its MRBSP tree, the RF
-// volumes' isosurfaces and slices merged into the tree (Wiley et al. 1997, section 4.2), and
-// the VTK renderer. The window slides (section 4.3) whenever the camera nears its edge, in the
-// same scene frame, so a long flight over a large mosaic holds one window in memory.
-// Used by `terravol render` and `terravol fly`.
+// The scene pipeline: a whole scene drawn frame after frame, the one that `terravol render`,
+// `view`, `fly` and `bench` share. It owns the DEM mosaic, the window of it and the window's
+// MRBSP tree, the RF volumes' isosurfaces and slices merged into the tree (Wiley et al. 1997,
+// section 4.2), the slides and the VTK renderer. The window slides (section 4.3) whenever the
+// camera nears its edge, in the same scene frame, so a long flight over a large mosaic holds
+// one window in memory: synchronously, within the frame (render, fly, bench), or read ahead and
+// shaded on a worker thread and finished at the first frame after that (view), through the
+// same code.
 #pragma once
 
-#include <chrono>
 #include <cstddef>
+#include <future>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera.h"
 #include "app/scene/scene_file.h"
+#include "app/scene/style.h"
 #include "app/scene/terrain_colors.h"
 #include "app/scene/terrain_scene.h"
 #include "app/scene/volume_layer.h"
@@ -28,33 +34,92 @@ struct FrameStats {
   std::size_t nodes_visited = 0;
   double traversal_ms = 0, upload_ms = 0, draw_ms = 0;
   int slides = 0;        // window slides so far (this frame's included)
-  double slide_ms = 0;   // this frame's slide and re-merge, 0 when none
+  double slide_ms = 0;   // this frame's slide on the calling thread (re-merge included), 0 when none
   double eye_height = 0, ground_height = 0;  // metres, DEM datum
+};
+
+// When the window slides, once the camera is within a quarter of its side of an edge.
+enum class Sliding : std::uint8_t {
+  kSynchronous,   // within the frame: read the moved window, shade it, slide the tree
+  kAsynchronous,  // read and shade on a worker thread; the first frame after that slides the tree
+};
+
+struct SceneOptions {
+  int max_window = 1024;  // cells, a power of two >= 2
+  int levels = 0;         // 0: scene::default_levels(window)
+  scene::ShadingOptions shading;
+  bool legend = true;     // a colour legend for the volumes
+  std::size_t surface_triangles = scene::kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
+  Sliding sliding = Sliding::kSynchronous;
+};
+
+// The pipeline's options and the renderer's settings as a resolved style gives them (window,
+// shading, legend, surface triangles; size, order, the sky gradient and its haze), for the
+// commands to adjust.
+SceneOptions scene_options(const scene::Style& style, int levels = 0, Sliding sliding = Sliding::kSynchronous);
+RenderSettings render_settings(const scene::Style& style);
+
+// The last slide's parts, milliseconds.
+struct SlideFigures {
+  double read_ms = 0, shade_ms = 0;     // reading the moved window and shading it (kAsynchronous: off thread)
+  double tree_ms = 0, vertices_ms = 0;  // sliding the tree (merging again), replacing the renderer's vertices
 };
 
 class SceneRenderer {
  public:
-  // Opens the mosaic (scene.dems), chooses the first window around scene.camera (else the
+  // Chooses the first window around scene.camera (else scene::default_pose(mosaic), above the
   // mosaic's centre), builds the tree, reads every volume and merges the visible ones'
-  // geometry. settings.gradient: the sky follows each frame's pitch. Throws io::FormatError
-  // for bad DEM or volume files, std::invalid_argument for bad styles (a slice outside its
-  // volume, ...) and std::runtime_error without an X display.
-  SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, int max_window = 1024, int levels = 0,
-                const scene::ShadingOptions& shading = {}, bool legend = true,
-                std::size_t surface_triangles = scene::kDefaultSurfaceTriangles);
+  // geometry (scene.dems is not read: the mosaic is given). settings.gradient: the sky follows
+  // each frame's pitch. Throws std::runtime_error when the camera is outside the mosaic or
+  // without an X display, io::FormatError for bad DEM or volume files and std::invalid_argument
+  // for bad styles (a slice outside its volume, a bad level count, ...).
+  SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
+                const SceneOptions& options = {});
+  // The same, opening the mosaic of scene.dems.
+  SceneRenderer(const scene::SceneSpec& scene, const RenderSettings& settings, const SceneOptions& options = {});
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
-  // Renders the view of `pose` (alt above the ground when agl). Slides the window first when
-  // the camera is within a quarter of its side of an edge. Throws std::runtime_error when the
-  // camera is outside the mosaic or not above the ground.
+  // Renders the view of `pose` (alt above the ground when agl): prepare(), then draw().
   FrameStats render(const scene::CameraPose& pose, bool agl, double fov_y_deg, const mrbsp::TraversalOptions& traversal);
+  // Everything of a frame but the draw: slides the window first (see Sliding) when auto-slide is
+  // on and the camera is within a quarter of the window's side of an edge, sets the camera (the
+  // window's current size in pixels) and the sky, traverses the tree and replaces the triangle
+  // list. Throws std::runtime_error when the camera is outside the mosaic or not above the
+  // ground, and, with kSynchronous, io::FormatError when the moved window cannot be read.
+  FrameStats prepare(const scene::CameraPose& pose, bool agl, double fov_y_deg,
+                     const mrbsp::TraversalOptions& traversal);
+  // Draws the prepared frame and waits for it; returns wall milliseconds.
+  double draw();
+  // The slide prepare() would make for a camera at `pose`, without a frame (terravol fly
+  // --resume makes the slides of the frames it skips). Returns whether the window moved.
+  bool slide_for(const scene::CameraPose& pose);
+
+  // The eye's height in the DEM's datum for `pose` (pose.alt plus the ground under it when agl).
+  // Throws std::runtime_error("camera at H m is not above the ground (G m there)...") when it is
+  // not above the ground.
+  double eye_height(const scene::CameraPose& pose, bool agl) const;
+
+  // Automatic sliding (on at the start). Off, the window stays where it is; a slide already
+  // read ahead still finishes.
+  void set_auto_slide(bool on) { auto_slide_ = on; }
+  bool auto_slide() const { return auto_slide_; }
+  // kAsynchronous: a moved window is being read (or waits to be slid to); it is ready when
+  // the next prepare() would slide to it.
+  bool slide_pending() const { return pending_.valid(); }
+  bool slide_ready() const;
+  // kAsynchronous: the error of a read ahead that failed (its one line), once; sliding is then
+  // off (set_auto_slide(true) tries again).
+  std::optional<std::string> take_slide_error();
+  int slides() const { return slides_; }
+  const SlideFigures& last_slide() const { return last_slide_; }
 
   std::vector<std::uint8_t> rgb() const;  // the last image: width * height * 3 bytes, top row first
 
   // Bilinear ground height (metres, DEM datum) anywhere in the mosaic, voids filled.
   double ground_height(double lat, double lon) const;
+  const io::Mosaic& mosaic() const { return mosaic_; }
   const io::SceneFrame& frame() const { return scene_->frame(); }
   const scene::TerrainScene& terrain() const { return *scene_; }
   TerrainRenderer& renderer() { return *renderer_; }
@@ -71,19 +136,33 @@ class SceneRenderer {
   const scene::TerrainShading& lattice_shading() const { return lattice_; }
 
   // Interactive changes to the volumes (VolumeLayer::set_slice, ...), then remerge(): merges
-  // every visible volume into the tree again and uploads the vertices (what terravol view
-  // does after a key). Returns what the merge cost.
+  // every visible volume into the tree again, uploads the vertices and updates the legend
+  // (what terravol view does after a key). Returns what the merge cost.
   scene::VolumeLayer& volumes() { return volumes_; }
   const scene::MergeFigures& remerge();
 
  private:
+  // A moved window read from the mosaic and shaded, ready to slide to.
+  struct PreparedSlide {
+    scene::SceneWindow window;
+    scene::TerrainShading lattice;
+    scene::TerrainShading vertices;  // of a tree without merged polygons; else empty (made after the slide)
+    double read_ms = 0, shade_ms = 0;
+  };
   void upload_vertices();
-  void check_inside(const scene::CameraPose& pose) const;
+  void slide(const scene::CameraPose& pose, FrameStats& stats);
+  std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
+  static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex, const scene::WindowChoice& next,
+                                     const io::SceneFrame& frame, const scene::ShadingOptions& shading,
+                                     std::size_t terrain_vertices);
+  void finish_slide(PreparedSlide&& prepared);
 
   io::Mosaic mosaic_;
+  // The mosaic's tile cache serves one reader at a time: a read ahead on the worker thread and
+  // ground_height() outside the window take turns.
+  mutable std::mutex mosaic_mutex_;
   RenderSettings settings_;
-  scene::ShadingOptions shading_;
-  bool legend_ = true;
+  SceneOptions options_;
   int levels_ = 0;
   std::unique_ptr<scene::TerrainScene> scene_;
   scene::TerrainShading lattice_;
@@ -91,7 +170,11 @@ class SceneRenderer {
   std::unique_ptr<TerrainRenderer> renderer_;
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
+  bool auto_slide_ = true;
   int slides_ = 0;
+  SlideFigures last_slide_;
+  std::optional<std::string> slide_error_;
+  std::future<PreparedSlide> pending_;  // declared last: waited for before anything it reads goes
 };
 
 }  // namespace terravol::app::render

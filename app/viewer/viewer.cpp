@@ -1,10 +1,12 @@
-// The interactive viewer (`terravol view`; docs/architecture.md, "The viewer"). One timer
-// drives everything: key and mouse events only change state and mark the view dirty; every
-// tick of a repeating timer moves the camera by the keys held (for the real time elapsed) and,
-// if anything changed, draws one frame: finish a slide whose window was read ahead, start one
-// if the camera nears the window's edge, traverse the tree, replace the triangle list, draw,
-// write the status file. Nothing is drawn while nothing changes. The interactor's own
-// rendering is switched off so that widgets and expose events only ask for a frame.
+// The interactive viewer (`terravol view`; docs/architecture.md, "The viewer"): input, overlay
+// and status around the scene pipeline (app/render/scene_renderer.h), which slides the window
+// on a worker thread here. One timer drives everything: key and mouse events only change state
+// and mark the view dirty; every tick of a repeating timer moves the camera by the keys held
+// (for the real time elapsed) and, if anything changed, draws one frame: the pipeline finishes
+// a slide whose window was read ahead, starts one if the camera nears the window's edge,
+// traverses the tree and replaces the triangle list; then the overlay, the draw and the status
+// file. Nothing is drawn while nothing changes. The interactor's own rendering is switched off
+// so that widgets and expose events only ask for a frame.
 #include "app/viewer/viewer.h"
 
 #include <nlohmann/json.hpp>
@@ -36,7 +38,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <future>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -45,11 +46,13 @@
 
 #include "app/output/png_output.h"
 #include "app/output/write_file.h"
+#include "app/render/scene_renderer.h"
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera_path.h"
+#include "app/scene/mosaic_lattice.h"
 #include "app/scene/terrain_scene.h"
+#include "app/scene/timing.h"
 #include "app/scene/volume_layer.h"
-#include "io/error.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::viewer {
@@ -77,24 +80,17 @@ const char* const kViewKeys =
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using nlohmann::ordered_json;
-
-double ms_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
+using scene::Clock;
+using scene::degrees;
+using scene::ms_between;
+using scene::ms_since;
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
-}
-
-std::string degrees(double v, char positive, char negative) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.5f %c", std::abs(v), v < 0 ? negative : positive);
-  return b;
 }
 
 // The slider's range per metric, log2 of the threshold: screen-space error 0.25..16 px,
@@ -125,13 +121,6 @@ constexpr auto kOverlayPeriod = std::chrono::milliseconds(250);
 
 class ViewerStyle;
 
-// A moved window read from the mosaic and shaded, ready to slide to.
-struct PreparedSlide {
-  scene::SceneWindow window;
-  scene::TerrainShading lattice, vertices;
-  double read_ms = 0, shade_ms = 0;
-};
-
 class Viewer {
  public:
   explicit Viewer(const ViewOptions& options);
@@ -154,9 +143,6 @@ class Viewer {
 
  private:
   void draw_frame();
-  void start_slide();
-  bool slide_ready() const;
-  void finish_slide();
   void set_metric(mrbsp::LodMetric m);
   void set_threshold(double t);
   void sync_slider();
@@ -167,29 +153,21 @@ class Viewer {
   // Held now, or pressed since the last tick (so that a tap shorter than a tick still moves).
   bool held(const char* key) const { return held_.count(key) > 0 || tapped_.count(key) > 0; }
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
-  void clamp_to_mosaic(scene::CameraPose& p) const;
   void volume_key(const std::string& key);
   void record_key();
   void save_path();
-  void upload_vertices();
 
   ViewOptions o_;
-  io::Mosaic mosaic_;
-  std::unique_ptr<scene::TerrainScene> scene_;
-  scene::TerrainShading lattice_;    // the window's lattice shading (its colours are the texture)
-  scene::VolumeLayer volumes_;
+  std::unique_ptr<render::SceneRenderer> pipeline_;  // the scene: window, tree, volumes, slides, renderer
   std::size_t selected_volume_ = 0;
   std::vector<scene::PathKey> keys_;  // recorded keyframes (K), saved by J
   Clock::time_point first_key_time_;
   double last_merge_ms_ = 0;  // the last interactive change of a volume, extraction to upload
-  std::future<PreparedSlide> pending_slide_;  // destroyed (waited for) before the mosaic
-  std::unique_ptr<render::TerrainRenderer> renderer_;
-  mrbsp::Frame frame_;
   scene::CameraPose pose_, start_pose_;
   scene::FlightSettings flight_;
   mrbsp::LodMetric metric_;
   double threshold_[2];  // per metric, [0] area, [1] error: each keeps its own
-  bool lod_colors_, wireframe_, auto_slide_, help_ = false;
+  bool lod_colors_, wireframe_, help_ = false;
   bool dirty_ = true, screenshot_pending_ = false;
   bool dragging_ = false;
   int drag_x_ = 0, drag_y_ = 0;
@@ -197,12 +175,9 @@ class Viewer {
   Clock::time_point start_, last_tick_;
 
   // Figures.
-  std::size_t frames_ = 0, slides_ = 0, screenshots_ = 0;
-  double frame_ms_ = 0, traversal_ms_ = 0, upload_ms_ = 0, draw_ms_ = 0, last_slide_ms_ = 0;
-  // The last slide: reading the window and shading it (worker thread), sliding the tree and
-  // replacing the vertices (this thread; last_slide_ms_ is their sum).
-  std::array<double, 4> slide_parts_{};
-  std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;
+  std::size_t frames_ = 0, screenshots_ = 0;
+  double frame_ms_ = 0, traversal_ms_ = 0, upload_ms_ = 0, draw_ms_ = 0;
+  std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;  // slide_log_: this thread's part
   std::filesystem::path last_screenshot_;
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
@@ -263,24 +238,6 @@ class ViewerStyle : public vtkInteractorStyle {
 
 vtkStandardNewMacro(ViewerStyle);
 
-scene::CameraPose default_pose(const io::Mosaic& m) {
-  const io::Georef& g = m.georef();
-  scene::CameraPose p;
-  p.lat = g.y0 - (m.rows() - 1) * g.dy / 2.0;
-  p.lon = std::remainder(g.x0 + (m.cols() - 1) * g.dx / 2.0, 360.0);
-  p.alt = 1500.0;  // above the ground
-  p.heading_deg = 0.0;
-  p.pitch_deg = -15.0;
-  return p;
-}
-
-// Fractional lattice row and column of a geographic point (row 0 north).
-void lattice_position(const io::Mosaic& m, double lat, double lon, double& row, double& col) {
-  const io::Georef& g = m.georef();
-  row = (g.y0 - lat) / g.dy;
-  col = (std::remainder(lon - g.x0 - 180.0, 360.0) + 180.0) / g.dx;
-}
-
 void style_text(vtkTextProperty* t, int size) {
   t->SetFontFamilyToCourier();
   t->SetFontSize(size);
@@ -293,62 +250,35 @@ void style_text(vtkTextProperty* t, int size) {
 
 Viewer::Viewer(const ViewOptions& options)
     : o_(options),
-      mosaic_(io::Mosaic::open(options.dems)),
       flight_(options.flight),
       metric_(options.style.traversal.metric),
       lod_colors_(options.lod_colors),
-      wireframe_(options.wireframe),
-      auto_slide_(options.auto_slide) {
+      wireframe_(options.wireframe) {
   threshold_[0] = mrbsp::default_threshold(mrbsp::LodMetric::kArea);
   threshold_[1] = mrbsp::default_threshold(mrbsp::LodMetric::kError);
   threshold() = options.style.traversal.threshold_px;
 
-  // The camera, inside the mosaic and above its ground.
+  // The scene around the camera, on screen; the camera inside the mosaic and above its ground.
+  io::Mosaic mosaic = io::Mosaic::open(options.dems);
   const bool given = options.pose.has_value();
-  pose_ = given ? *options.pose : default_pose(mosaic_);
+  pose_ = given ? *options.pose : scene::default_pose(mosaic);
   const bool agl = given ? options.agl : true;
-  double row = 0, col = 0;
-  lattice_position(mosaic_, pose_.lat, pose_.lon, row, col);
-  if (row < 0 || row > mosaic_.rows() - 1 || col < 0 || col > mosaic_.cols() - 1) {
-    const io::Georef& g = mosaic_.georef();
-    const double south = g.y0 - (mosaic_.rows() - 1) * g.dy, east = g.x0 + (mosaic_.cols() - 1) * g.dx;
-    throw std::runtime_error("camera " + degrees(pose_.lat, 'N', 'S') + ", " + degrees(pose_.lon, 'E', 'W') +
-                             " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
-                             ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
-  }
-  render::require_x_display();
-  const scene::WindowChoice window = scene::choose_window(mosaic_.rows(), mosaic_.cols(), row, col, o_.style.window);
-  scene_ = std::make_unique<scene::TerrainScene>(mosaic_, window, o_.levels > 0 ? o_.levels : scene::default_levels(window.cells));
-  const double ground = scene_->ground_height(pose_.lat, pose_.lon);
-  if (agl) pose_.alt += ground;
-  if (pose_.alt <= ground) {
-    char b[160];
-    std::snprintf(b, sizeof b, "camera at %.1f m is not above the ground (%.1f m there)%s", pose_.alt, ground,
-                  agl ? "" : "; use --agl for heights above ground");
-    throw std::runtime_error(b);
-  }
-  start_pose_ = pose_;
-
-  // The renderer, on screen.
-  render::RenderSettings settings;
-  settings.width = o_.style.width;
-  settings.height = o_.style.height;
-  settings.order = o_.style.order;
+  scene::SceneSpec spec;
+  spec.dems = o_.dems;
+  spec.volumes = o_.volumes;
+  spec.camera = scene::SceneCamera{pose_, agl, o_.fov_y_deg};
+  render::RenderSettings settings = render::render_settings(o_.style);
   settings.lod_colors = lod_colors_;
   settings.wireframe = wireframe_;
-  settings.gradient = true;
-  settings.haze_color = scene::kHorizon;
-  settings.haze_distance = o_.style.haze_km * 1000.0;
   settings.offscreen = false;
-  volumes_ = scene::VolumeLayer(o_.volumes, mosaic_, scene_->frame(), o_.style.surface_triangles);
-  volumes_.merge_into(*scene_);
-  lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(), o_.style.shading);
-  const mrbsp::TerrainTree& tree = scene_->tree();
-  renderer_ = std::make_unique<render::TerrainRenderer>(tree.positions(),
-                                                scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
-                                                settings, render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
-  if (o_.style.legend) renderer_->set_legend(volumes_.legend());
-  vtkRenderWindow* win = renderer_->window();
+  const render::SceneOptions scene_options = render::scene_options(o_.style, o_.levels, render::Sliding::kAsynchronous);
+  pipeline_ = std::make_unique<render::SceneRenderer>(std::move(mosaic), spec, settings, scene_options);
+  pipeline_->set_auto_slide(options.auto_slide);
+  pose_.alt = pipeline_->eye_height(pose_, agl);  // in the datum from here on
+  start_pose_ = pose_;
+
+  render::TerrainRenderer& renderer = pipeline_->renderer();
+  vtkRenderWindow* win = renderer.window();
   std::string title = "Terravol view - " + o_.dems.front().filename().string();
   if (o_.dems.size() > 1) title += " + " + std::to_string(o_.dems.size() - 1) + " more";
   win->SetWindowName(title.c_str());
@@ -392,7 +322,7 @@ Viewer::Viewer(const ViewOptions& options)
     slider_panel_->SetMapper(mapper);
     slider_panel_->GetProperty()->SetColor(0.05, 0.08, 0.12);
     slider_panel_->GetProperty()->SetOpacity(0.55);
-    renderer_->renderer()->AddActor2D(slider_panel_);
+    renderer.renderer()->AddActor2D(slider_panel_);
   }
   slider_rep_->GetPoint1Coordinate()->SetCoordinateSystemToNormalizedDisplay();
   slider_rep_->GetPoint1Coordinate()->SetValue(kSliderX0, kSliderY);
@@ -426,7 +356,7 @@ Viewer::Viewer(const ViewOptions& options)
     end->GetTextProperty()->SetBackgroundOpacity(0.0);
     end->GetTextProperty()->SetVerticalJustificationToBottom();
     end->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-    renderer_->renderer()->AddActor2D(end);
+    renderer.renderer()->AddActor2D(end);
   }
   slider_min_->GetTextProperty()->SetJustificationToLeft();
   slider_min_->SetPosition(kSliderX0, kSliderY + 0.032);
@@ -439,14 +369,14 @@ Viewer::Viewer(const ViewOptions& options)
   overlay_->GetTextProperty()->SetVerticalJustificationToTop();
   overlay_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   overlay_->SetPosition(0.008, 0.988);
-  renderer_->renderer()->AddActor2D(overlay_);
+  renderer.renderer()->AddActor2D(overlay_);
   style_text(help_text_->GetTextProperty(), 14);
   help_text_->GetTextProperty()->SetVerticalJustificationToBottom();
   help_text_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   help_text_->SetPosition(0.008, 0.015);
   help_text_->SetInput(kViewKeys);
   help_text_->SetVisibility(help_);
-  renderer_->renderer()->AddActor2D(help_text_);
+  renderer.renderer()->AddActor2D(help_text_);
 }
 
 Viewer::~Viewer() {
@@ -460,9 +390,9 @@ void Viewer::run() {
   draw_frame();
   interactor_->CreateRepeatingTimer(15);
   interactor_->Start();
-  std::printf("frames %zu: median %.1f ms (traversal %.1f ms, draw %.1f ms); slides %zu", frames_,
-              median(frame_log_), median(traversal_log_), median(draw_log_), slides_);
-  if (slides_ > 0) std::printf(": median %.0f ms", median(slide_log_));
+  std::printf("frames %zu: median %.1f ms (traversal %.1f ms, draw %.1f ms); slides %d", frames_,
+              median(frame_log_), median(traversal_log_), median(draw_log_), pipeline_->slides());
+  if (pipeline_->slides() > 0) std::printf(": median %.0f ms", median(slide_log_));
   std::printf("\n");
   std::fflush(stdout);
 }
@@ -492,14 +422,14 @@ void Viewer::key_press(const std::string& key) {
   }
   if (key == "l") {
     lod_colors_ = !lod_colors_;
-    renderer_->set_lod_colors(lod_colors_);
+    pipeline_->renderer().set_lod_colors(lod_colors_);
   } else if (key == "t") {
     wireframe_ = !wireframe_;
-    renderer_->set_wireframe(wireframe_);
+    pipeline_->renderer().set_wireframe(wireframe_);
   } else if (key == "m") {
     set_metric(metric_ == mrbsp::LodMetric::kError ? mrbsp::LodMetric::kArea : mrbsp::LodMetric::kError);
   } else if (key == "g") {
-    auto_slide_ = !auto_slide_;
+    pipeline_->set_auto_slide(!pipeline_->auto_slide());
   } else if (key == "p") {
     screenshot_pending_ = true;
   } else if (key == "k") {
@@ -551,19 +481,11 @@ void Viewer::wheel(int clicks) {
 // keys held now would go elsewhere; stop rather than fly on.
 void Viewer::leave() { held_.clear(); }
 
-void Viewer::clamp_to_mosaic(scene::CameraPose& p) const {
-  const io::Georef& g = mosaic_.georef();
-  const double south = g.y0 - (mosaic_.rows() - 1) * g.dy, west = g.x0;
-  p.lat = std::clamp(p.lat, south, g.y0);
-  const double east_of_west = std::remainder(p.lon - west - 180.0, 360.0) + 180.0;
-  p.lon = std::remainder(west + std::clamp(east_of_west, 0.0, (mosaic_.cols() - 1) * g.dx), 360.0);
-}
-
 void Viewer::tick() {
   // VTK's X event loop handles one event between timer checks, and a frame takes longer than
   // the timer's period: without this, events (a held key's repeats first) would queue up
   // faster than they are handled, and a key's release would come seconds late.
-  Display* display = static_cast<Display*>(renderer_->window()->GetGenericDisplayId());
+  Display* display = static_cast<Display*>(pipeline_->renderer().window()->GetGenericDisplayId());
   while (XPending(display) > 0) {
     XEvent event;
     XNextEvent(display, &event);
@@ -575,14 +497,14 @@ void Viewer::tick() {
   last_tick_ = now;
   const scene::FlightInput in = input();
   if (in.moving()) {
-    const scene::TerrainScene& scene = *scene_;
-    pose_ = scene::fly(pose_, in, dt, scene.frame(),
-                [&scene](double lat, double lon) { return scene.ground_height(lat, lon); }, flight_);
-    clamp_to_mosaic(pose_);
+    const render::SceneRenderer& pipeline = *pipeline_;
+    pose_ = scene::fly(pose_, in, dt, pipeline.frame(),
+                       [&pipeline](double lat, double lon) { return pipeline.ground_height(lat, lon); }, flight_);
+    scene::clamp_to_mosaic(pipeline.mosaic(), pose_.lat, pose_.lon);
     dirty_ = true;
   }
   tapped_.clear();
-  if (slide_ready()) dirty_ = true;
+  if (pipeline_->slide_ready()) dirty_ = true;
   if (overlay_stale_ && now - overlay_time_ >= kOverlayPeriod) dirty_ = true;
   if (dirty_ || screenshot_pending_) {
     dirty_ = false;
@@ -594,7 +516,8 @@ void Viewer::tick() {
 // isosurface. Each change re-extracts that one piece of geometry, merges all visible geometry
 // into the tree again and uploads the vertices; the overlay and the status say how long it took.
 void Viewer::volume_key(const std::string& key) {
-  if (volumes_.size() == 0) {
+  scene::VolumeLayer& volumes = pipeline_->volumes();
+  if (volumes.size() == 0) {
     message_ = "no volumes (give --volume or --scene)";
     return;
   }
@@ -603,15 +526,15 @@ void Viewer::volume_key(const std::string& key) {
   try {
     if (key[0] >= '1' && key[0] <= '9') {
       const std::size_t v = static_cast<std::size_t>(key[0] - '1');
-      if (v >= volumes_.size()) {
+      if (v >= volumes.size()) {
         message_ = "there is no volume " + key;
         return;
       }
       selected_volume_ = v;
-      volumes_.set_visible(v, !volumes_.spec(v).visible);
-      what = "volume " + key + (volumes_.spec(v).visible ? " shown" : " hidden");
+      volumes.set_visible(v, !volumes.spec(v).visible);
+      what = "volume " + key + (volumes.spec(v).visible ? " shown" : " hidden");
     } else if (key == "bracketleft" || key == "bracketright") {
-      const scene::VolumeSpec& spec = volumes_.spec(selected_volume_);
+      const scene::VolumeSpec& spec = volumes.spec(selected_volume_);
       if (spec.slices.empty()) {
         message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no slice";
         return;
@@ -619,20 +542,20 @@ void Viewer::volume_key(const std::string& key) {
       volume::SliceSpec s = spec.slices.front();
       const bool degrees = s.kind == volume::SliceKind::kLat || s.kind == volume::SliceKind::kLon;
       s.value += (key == "bracketright" ? 1.0 : -1.0) * (degrees ? 0.01 : 50.0);
-      volumes_.set_slice(selected_volume_, 0, s);
+      volumes.set_slice(selected_volume_, 0, s);
       char b[96];
       std::snprintf(b, sizeof b, "slice %s %g%s", std::string(volume::slice_kind_name(s.kind)).c_str(), s.value,
                     degrees ? " deg" : " m");
       what = b;
     } else {
-      const scene::VolumeSpec& spec = volumes_.spec(selected_volume_);
+      const scene::VolumeSpec& spec = volumes.spec(selected_volume_);
       if (spec.isosurfaces.empty()) {
         message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no isosurface";
         return;
       }
       volume::IsoSpec iso = spec.isosurfaces.front();
       iso.value += key == "period" ? 2.0f : -2.0f;
-      volumes_.set_isosurface(selected_volume_, 0, iso);
+      volumes.set_isosurface(selected_volume_, 0, iso);
       char b[64];
       std::snprintf(b, sizeof b, "isosurface %g", static_cast<double>(iso.value));
       what = b;
@@ -641,14 +564,12 @@ void Viewer::volume_key(const std::string& key) {
     message_ = e.what();  // e.g. a slice moved out of its volume: nothing changed
     return;
   }
-  const double geometry_ms = volumes_.figures().geometry_ms;
-  volumes_.merge_into(*scene_);
-  upload_vertices();
-  if (o_.style.legend) renderer_->set_legend(volumes_.legend());
-  last_merge_ms_ = ms_between(t0, Clock::now());
+  const double geometry_ms = volumes.figures().geometry_ms;
+  const scene::MergeFigures& merge = pipeline_->remerge();
+  last_merge_ms_ = ms_since(t0);
   char b[160];
   std::snprintf(b, sizeof b, "%s: %.0f ms (geometry %.0f, merge %.0f)", what.c_str(), last_merge_ms_, geometry_ms,
-                volumes_.figures().merge_ms);
+                merge.merge_ms);
   message_ = b;
 }
 
@@ -696,12 +617,6 @@ void Viewer::save_path() {
   }
 }
 
-void Viewer::upload_vertices() {
-  const mrbsp::TerrainTree& tree = scene_->tree();
-  renderer_->replace_vertices(tree.positions(), scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
-                              render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
-}
-
 void Viewer::slider_moved() {
   const double t = std::exp2(slider_rep_->GetValue());
   threshold() = t;
@@ -734,94 +649,26 @@ void Viewer::sync_slider() {
   slider_max_->SetInput(error ? "coarser  16 px" : "coarser  32768 px^2");
 }
 
-// Sliding runs in two halves. start_slide(), when the camera is within a quarter of the window
-// of its edge, reads the moved window from the mosaic and shades it on a worker thread (the
-// camera still has a quarter of the window ahead meanwhile); finish_slide(), at the first frame
-// after it is ready, slides the tree and replaces the renderer's vertices on this thread.
-void Viewer::start_slide() {
-  if (pending_slide_.valid()) return;
-  double row = 0, col = 0;
-  lattice_position(mosaic_, pose_.lat, pose_.lon, row, col);
-  const scene::WindowChoice& now = scene_->window();
-  const int step = 1 << (scene_->tree().levels() - 1);  // samples across one coarsest-level cell
-  const scene::WindowChoice next = scene::plan_slide(now, mosaic_.rows(), mosaic_.cols(), row, col, step);
-  if (next.row0 == now.row0 && next.col0 == now.col0) return;
-  const mrbsp::TerrainTree& tree = scene_->tree();
-  pending_slide_ = std::async(std::launch::async, [mosaic = &mosaic_, next, frame = scene_->frame(),
-                                                   shading = o_.style.shading, base = tree.merged_base(),
-                                                   merged = tree.merged_colors()] {
-    PreparedSlide p;
-    const auto t0 = Clock::now();
-    p.window = scene::read_scene_window(*mosaic, next, frame);
-    const auto t1 = Clock::now();
-    p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, shading);
-    p.vertices = scene::vertex_shading(p.lattice, base, merged);
-    p.read_ms = ms_between(t0, t1);
-    p.shade_ms = ms_between(t1, Clock::now());
-    return p;
-  });
-}
-
-bool Viewer::slide_ready() const {
-  return pending_slide_.valid() &&
-         pending_slide_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
-}
-
-void Viewer::finish_slide() {
-  if (!slide_ready()) return;
-  PreparedSlide p;
-  try {
-    p = pending_slide_.get();
-  } catch (const io::FormatError& e) {
-    std::fprintf(stderr, "terravol: %s (automatic sliding turned off)\n", e.what());
-    auto_slide_ = false;
-    return;
-  }
-  const auto t0 = Clock::now();
-  scene_->slide(std::move(p.window));  // merges the volumes again into the moved window
-  lattice_ = std::move(p.lattice);
-  const auto t1 = Clock::now();
-  if (volumes_.size() > 0) {
-    // The merged vertices were made anew by the slide: their count and colours changed.
-    p.vertices = scene::vertex_shading(lattice_, scene_->tree().merged_base(), scene_->tree().merged_colors());
-  }
-  renderer_->replace_vertices(scene_->tree().positions(), p.vertices, render::ColorTexture{scene_->cells() + 1, lattice_.rgba});
-  const auto t2 = Clock::now();
-  slide_parts_ = {p.read_ms, p.shade_ms, ms_between(t0, t1), ms_between(t1, t2)};
-  last_slide_ms_ = ms_between(t0, t2);
-  slide_log_.push_back(last_slide_ms_);
-  ++slides_;
-}
-
 void Viewer::draw_frame() {
   const auto t0 = Clock::now();
-  finish_slide();
-  if (auto_slide_) start_slide();
-  const int* size = renderer_->window()->GetSize();
-  const int width = std::max(size[0], 1), height = std::max(size[1], 1);
-  const double ground = scene_->ground_height(pose_.lat, pose_.lon);
-  const double agl = pose_.alt - ground;
-  const double speed = scene::flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
-  const mrbsp::Camera camera =
-      scene::make_scene_camera(scene_->frame(), pose_, pose_.alt, o_.fov_y_deg, width, height, scene::near_plane_for(agl));
-  renderer_->set_camera(camera, scene_->far_plane(camera.eye));
-  const auto sky = scene::sky_gradient(pose_.pitch_deg, o_.fov_y_deg);
-  renderer_->renderer()->SetBackground(sky[0][0] / 255.0, sky[0][1] / 255.0, sky[0][2] / 255.0);
-  renderer_->renderer()->SetBackground2(sky[1][0] / 255.0, sky[1][1] / 255.0, sky[1][2] / 255.0);
-
   mrbsp::TraversalOptions traversal = o_.style.traversal;
   traversal.metric = metric_;
   traversal.threshold_px = static_cast<float>(threshold());
-  const auto t1 = Clock::now();
-  scene_->tree().traverse(camera, traversal, frame_);
-  const auto t2 = Clock::now();
-  renderer_->set_frame(frame_);
-  const auto t3 = Clock::now();
-  traversal_ms_ = ms_between(t1, t2);
-  upload_ms_ = ms_between(t2, t3);
+  const int slides = pipeline_->slides();
+  // Finishes a slide read ahead, starts reading the next when the camera nears the window's
+  // edge, then the camera (at the window's current size), the sky, the traversal.
+  const render::FrameStats f = pipeline_->prepare(pose_, false, o_.fov_y_deg, traversal);
+  if (const auto error = pipeline_->take_slide_error()) {
+    std::fprintf(stderr, "terravol: %s (automatic sliding turned off)\n", error->c_str());
+  }
+  if (f.slides > slides) slide_log_.push_back(f.slide_ms);
+  const double agl = f.eye_height - f.ground_height;
+  const double speed = scene::flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
+  traversal_ms_ = f.traversal_ms;
+  upload_ms_ = f.upload_ms;
   update_overlay(agl, speed);
-  draw_ms_ = renderer_->render();
-  frame_ms_ = ms_between(t0, Clock::now());
+  draw_ms_ = pipeline_->draw();
+  frame_ms_ = ms_since(t0);
   if (frames_ > 0) {  // the first frame compiles shaders and uploads every vertex
     frame_log_.push_back(frame_ms_);
     traversal_log_.push_back(traversal_ms_);
@@ -832,22 +679,24 @@ void Viewer::draw_frame() {
     screenshot_pending_ = false;
     save_screenshot();
   }
-  write_status(agl, speed, camera);
+  write_status(agl, speed, pipeline_->camera());
 }
 
 // The text is drawn again (FreeType, then a texture) only when a setting in it changes or a
 // quarter second has passed: redrawing it every frame cost about 7 ms per frame. tick() brings
 // a last frame when the camera stops, so the figures do not stay stale.
 void Viewer::update_overlay(double agl, double speed) {
-  const scene::WindowChoice& w = scene_->window();
+  const scene::WindowChoice& w = pipeline_->terrain().window();
+  const render::SlideFigures& slide = pipeline_->last_slide();
   const bool error = metric_ == mrbsp::LodMetric::kError;
   char settings[512];
   std::snprintf(settings, sizeof settings,
                 "LOD %s %s   colours %s   wireframe %s\n"
-                "window %d cells at row %d, col %d   slides %zu (last %.0f ms)   auto-slide %s\n%s",
+                "window %d cells at row %d, col %d   slides %d (last %.0f ms)   auto-slide %s\n%s",
                 error ? "error" : "area", threshold_text(metric_, threshold()).c_str(), lod_colors_ ? "on" : "off",
-                wireframe_ ? "on" : "off", w.cells, w.row0, w.col0, slides_, last_slide_ms_,
-                auto_slide_ ? "on" : "off", message_.empty() ? "H: keys" : message_.c_str());
+                wireframe_ ? "on" : "off", w.cells, w.row0, w.col0, pipeline_->slides(),
+                slide.tree_ms + slide.vertices_ms, pipeline_->auto_slide() ? "on" : "off",
+                message_.empty() ? "H: keys" : message_.c_str());
   const auto now = Clock::now();
   if (settings == overlay_settings_ && now - overlay_time_ < kOverlayPeriod) {
     overlay_stale_ = true;  // it shows older figures: tick() refreshes it once the camera stops
@@ -860,7 +709,8 @@ void Viewer::update_overlay(double agl, double speed) {
   std::snprintf(b, sizeof b,
                 "%zu triangles, %zu nodes   frame %.0f ms (traversal %.1f, draw %.0f)\n"
                 "%s %s   alt %.0f m   AGL %.0f m   heading %.0f   pitch %.0f   speed %.0f m/s\n",
-                frame_.indices.size() / 3, frame_.nodes_visited, frame_ms_, traversal_ms_, draw_ms_,
+                pipeline_->last_frame().indices.size() / 3, pipeline_->last_frame().nodes_visited, frame_ms_,
+                traversal_ms_, draw_ms_,
                 degrees(pose_.lat, 'N', 'S').c_str(), degrees(pose_.lon, 'E', 'W').c_str(), pose_.alt, agl,
                 pose_.heading_deg, pose_.pitch_deg, speed);
   overlay_->SetInput((b + overlay_settings_).c_str());
@@ -876,7 +726,7 @@ void Viewer::save_screenshot() {
     }
   }
   try {
-    output::write_png(path, output::window_png(renderer_->window()), true);
+    output::write_png(path, output::window_png(pipeline_->renderer().window()), true);
     ++screenshots_;
     last_screenshot_ = path;
     message_ = "wrote " + path.string();
@@ -889,9 +739,12 @@ void Viewer::save_screenshot() {
 
 void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera) {
   if (o_.status.empty()) return;
-  const scene::WindowChoice& w = scene_->window();
-  const scene::WindowBounds b = scene_->bounds();
-  const int* size = renderer_->window()->GetSize();
+  const scene::TerrainScene& terrain = pipeline_->terrain();
+  const scene::WindowChoice& w = terrain.window();
+  const scene::WindowBounds b = terrain.bounds();
+  const int* size = pipeline_->renderer().window()->GetSize();
+  const mrbsp::Frame& frame = pipeline_->last_frame();
+  const render::SlideFigures& slide = pipeline_->last_slide();
   // The slider's knob centre at the range's ends, in window pixels from the top left
   // (vtkSliderRepresentation2D: caps at both ends, the knob slides between them).
   const double x0 = kSliderX0 * size[0], x1 = kSliderX1 * size[0];
@@ -901,13 +754,13 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   ordered_json j;
   j["frame"] = frames_;
   j["time_s"] = std::chrono::duration<double>(Clock::now() - start_).count();
-  j["triangles"] = frame_.indices.size() / 3;
-  j["nodes_visited"] = frame_.nodes_visited;
+  j["triangles"] = frame.indices.size() / 3;
+  j["nodes_visited"] = frame.nodes_visited;
   j["threshold"] = threshold();
   j["metric"] = metric_ == mrbsp::LodMetric::kError ? "error" : "area";
   j["lod_colors"] = lod_colors_;
   j["wireframe"] = wireframe_;
-  j["auto_slide"] = auto_slide_;
+  j["auto_slide"] = pipeline_->auto_slide();
   j["camera"] = {{"lat", pose_.lat},
                  {"lon", pose_.lon},
                  {"alt", pose_.alt},
@@ -921,16 +774,17 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["traversal_ms"] = traversal_ms_;
   j["upload_ms"] = upload_ms_;
   j["draw_ms"] = draw_ms_;
-  j["slides"] = slides_;
-  j["last_slide_ms"] = last_slide_ms_;
-  j["last_slide_parts_ms"] = {{"read_window", slide_parts_[0]},
-                              {"shading", slide_parts_[1]},
-                              {"tree", slide_parts_[2]},
-                              {"vertices", slide_parts_[3]}};
-  j["slide_pending"] = pending_slide_.valid();
+  j["slides"] = pipeline_->slides();
+  j["last_slide_ms"] = slide.tree_ms + slide.vertices_ms;  // this thread's part
+  j["last_slide_parts_ms"] = {{"read_window", slide.read_ms},
+                              {"shading", slide.shade_ms},
+                              {"tree", slide.tree_ms},
+                              {"vertices", slide.vertices_ms}};
+  j["slide_pending"] = pipeline_->slide_pending();
+  scene::VolumeLayer& volumes = pipeline_->volumes();
   j["volumes"] = ordered_json::array();
-  for (std::size_t v = 0; v < volumes_.size(); ++v) {
-    const scene::VolumeSpec& spec = volumes_.spec(v);
+  for (std::size_t v = 0; v < volumes.size(); ++v) {
+    const scene::VolumeSpec& spec = volumes.spec(v);
     ordered_json jv;
     jv["visible"] = spec.visible;
     jv["isovalues"] = ordered_json::array();
@@ -939,12 +793,18 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
     for (const auto& s : spec.slices) jv["slices"].push_back({{"kind", volume::slice_kind_name(s.kind)}, {"value", s.value}});
     j["volumes"].push_back(jv);
   }
-  j["merged_triangles"] = volumes_.figures().tree_triangles;
+  const scene::MergeFigures& merge = pipeline_->merge_figures();
+  j["merged_triangles"] = merge.tree_triangles;
+  j["merge"] = {{"input_triangles", merge.input_triangles},
+                {"tree_triangles", merge.tree_triangles},
+                {"surface_triangles", o_.style.surface_triangles},
+                {"geometry_ms", merge.geometry_ms},
+                {"merge_ms", merge.merge_ms}};
   j["last_merge_ms"] = last_merge_ms_;
   j["message"] = message_;
   // Nothing will draw another frame until something happens: no key held, no slide read
   // ahead, no overlay refresh or screenshot due.
-  j["idle"] = held_.empty() && !pending_slide_.valid() && !overlay_stale_ && !screenshot_pending_ && !dirty_;
+  j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_;
   j["window"] = {{"cells", w.cells},
                  {"row0", w.row0},
                  {"col0", w.col0},
@@ -952,8 +812,8 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                  {"north", b.north},
                  {"west", b.west},
                  {"east", b.east},
-                 {"origin_lat", scene_->frame().lat0()},
-                 {"origin_lon", scene_->frame().lon0()}};
+                 {"origin_lat", terrain.frame().lat0()},
+                 {"origin_lon", terrain.frame().lon0()}};
   j["size"] = {size[0], size[1]};
   j["slider"] = {{"x_min", knob_lo},
                  {"x_max", knob_hi},

@@ -1,7 +1,8 @@
 // `terravol view`: the interactive viewer. An on-screen VTK window over the terrain of a DEM
-// mosaic, drawn through the MRBSP tree in back-to-front order, with flight controls, an LOD
-// threshold slider, a text overlay, and a window that slides over the mosaic with the camera
-// (Wiley et al. 1997, section 4.3). Key bindings: kViewKeys.
+// mosaic, drawn by the scene pipeline (app/render/scene_renderer.h) through the MRBSP tree in
+// back-to-front order, with flight controls, an LOD threshold slider, a text overlay, and a
+// window that slides over the mosaic with the camera, read ahead on a worker thread (Wiley et
+// al. 1997, section 4.3). Key bindings: kViewKeys.
 #pragma once
 
 #include <filesystem>
