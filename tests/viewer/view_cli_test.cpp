@@ -606,6 +606,38 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
   EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
 
+// Isosurfaces and slices are decimated to --surface-triangles each (12000 by default: this
+// volume's isosurface and slice give 23999 triangles), or to the scene file's
+// "surface_triangles"; the option wins over the file.
+TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceAndSliceFromTheOptionOrTheSceneFile) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  const auto r = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
+                                    " --radius-km 5 --heights 0:1000:100 -o " + vdb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto scene = dir.path() / "scene.json";
+  std::ofstream(scene) << R"({"dem": ")" << bundled_dem() << R"(", "volumes": [{"file": ")" << vdb.string()
+                       << R"(", "isosurfaces": [{"value": 110}], "slices": [{"agl": 300}]}],
+    "camera": {"lat": 45.44, "lon": 6.44, "alt": 2600, "heading": 40, "pitch": -18},
+    "render": {"surface_triangles": 2000}})";
+  const auto input_triangles = [&](const std::string& args) -> std::size_t {
+    Viewer v("--scene " + scene.string() + args + kSmall);
+    if (!v.start()) return 0;
+    const json s = v.settle();
+    v.xdo("key q");
+    EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+    EXPECT_GT(s["merged_triangles"].get<std::size_t>(), 0u);
+    return s["merge"]["input_triangles"].get<std::size_t>();
+  };
+  const std::size_t from_file = input_triangles("");
+  EXPECT_GT(from_file, 0u);
+  EXPECT_LE(from_file, 2u * 2000u) << "the scene file's budget, for the isosurface and the slice";
+  const std::size_t from_option = input_triangles(" --surface-triangles 4000");
+  EXPECT_GT(from_option, 2u * 2000u) << "the option wins over the file";
+  EXPECT_LE(from_option, 2u * 4000u);
+}
+
 TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
   TERRAVOL_REQUIRE_XDOTOOL();
   test::TempDir dir;

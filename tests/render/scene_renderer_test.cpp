@@ -1,0 +1,146 @@
+// app/render/scene_renderer.h: the scene pipeline's slides, synchronous (render, fly) and read
+// ahead on a worker thread (view), over the bundled DEM.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/render/scene_renderer.h"
+#include "app/scene/camera.h"
+#include "app/scene/scene_file.h"
+#include "io/grid.h"
+#include "io/mosaic.h"
+#include "io/void_fill.h"
+#include "require_display.h"
+#include "run_command.h"
+#include "temp_dir.h"
+#include "volume/geometry.h"
+
+namespace terravol::app::render {
+namespace {
+
+std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
+
+// The first window is centred on (45.5 N, 6.5 E), lattice row and column 600 of the tile; the
+// frames look from 100 samples farther north, within a quarter of the 256-cell window of its
+// north edge, so the first of them slides the window north.
+constexpr double kStartLat = 45.5, kLon = 6.5;
+constexpr double kNorthLat = 46.0 - 500.0 / 1200.0;
+
+scene::SceneSpec scene_spec(const std::vector<scene::VolumeSpec>& volumes = {}) {
+  scene::SceneSpec spec;
+  spec.dems = {bundled_dem()};
+  spec.volumes = volumes;
+  spec.camera = scene::SceneCamera{scene::CameraPose{kStartLat, kLon, 1500.0, 0.0, -20.0}, true, 45.0};
+  return spec;
+}
+
+RenderSettings small_settings() {
+  RenderSettings s;
+  s.width = 160;
+  s.height = 90;
+  return s;
+}
+
+SceneOptions options(Sliding sliding) {
+  SceneOptions o;
+  o.max_window = 256;
+  o.sliding = sliding;
+  o.surface_triangles = 2000;
+  return o;
+}
+
+const scene::CameraPose kNorth{kNorthLat, kLon, 1500.0, 0.0, -20.0};
+
+// Renders the northern view until the window has slid once; false after 60 s.
+bool render_until_slid(SceneRenderer& r) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < end) {
+    if (r.render(kNorth, true, 45.0, {}).slides == 1) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+// The heights of the window, row 0 south, as the mosaic itself gives them (voids filled).
+std::vector<float> mosaic_heights(const scene::WindowChoice& w) {
+  const io::Mosaic mosaic = io::Mosaic::open({bundled_dem()});
+  io::Grid g = mosaic.read_window(w.row0, w.col0, w.cells + 1, w.cells + 1);
+  io::fill_voids(g);
+  std::vector<float> h;
+  for (int j = 0; j <= w.cells; ++j)
+    for (int i = 0; i <= w.cells; ++i) h.push_back(g.heights[g.index(w.cells - j, i)]);
+  return h;
+}
+
+void expect_same_slide(SceneRenderer& sync, SceneRenderer& async) {
+  const scene::WindowChoice& a = sync.terrain().window();
+  const scene::WindowChoice& b = async.terrain().window();
+  EXPECT_EQ(a.row0, b.row0);
+  EXPECT_EQ(a.col0, b.col0);
+  EXPECT_LT(a.row0, 600 - 128) << "the window moved north";
+  EXPECT_EQ((600 - 128 - a.row0) % 32, 0) << "by whole cells of the coarsest level (6 levels: 32 samples)";
+  const std::vector<float> expected = mosaic_heights(a);
+  const auto heights = async.terrain().heights();
+  ASSERT_EQ(heights.size(), expected.size());
+  EXPECT_TRUE(std::equal(heights.begin(), heights.end(), expected.begin())) << "the moved window's samples";
+  EXPECT_EQ(sync.terrain().tree().positions(), async.terrain().tree().positions());
+  EXPECT_EQ(sync.last_frame().indices, async.last_frame().indices);
+  EXPECT_EQ(sync.rgb(), async.rgb()) << "the same picture after either slide";
+}
+
+TEST(SceneRenderer, TheSynchronousSlideHappensWithinTheFrame) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  SceneRenderer r(scene_spec(), small_settings(), options(Sliding::kSynchronous));
+  EXPECT_EQ(r.render(scene_spec().camera->pose, true, 45.0, {}).slides, 0) << "centred: no slide";
+  const FrameStats f = r.render(kNorth, true, 45.0, {});
+  EXPECT_EQ(f.slides, 1);
+  EXPECT_GT(f.slide_ms, 0.0);
+  EXPECT_FALSE(r.slide_pending());
+}
+
+TEST(SceneRenderer, AReadAheadSlideLandsAtALaterFrameAsTheSynchronousOneDoes) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  SceneRenderer sync(scene_spec(), small_settings(), options(Sliding::kSynchronous));
+  SceneRenderer async(scene_spec(), small_settings(), options(Sliding::kAsynchronous));
+  ASSERT_EQ(sync.render(kNorth, true, 45.0, {}).slides, 1);
+  const FrameStats first = async.render(kNorth, true, 45.0, {});
+  EXPECT_EQ(first.slides, 0) << "the moved window is read on the worker thread, not in this frame";
+  EXPECT_TRUE(async.slide_pending());
+  ASSERT_TRUE(render_until_slid(async));
+  EXPECT_FALSE(async.slide_pending());
+  EXPECT_GT(async.last_slide().read_ms, 0.0);
+  EXPECT_GT(async.last_slide().tree_ms, 0.0);
+  sync.render(kNorth, true, 45.0, {});
+  expect_same_slide(sync, async);
+}
+
+TEST(SceneRenderer, BothSlidesMergeTheVolumesAgainIntoTheMovedWindow) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  const auto r = test::run_terravol("rf --quiet --tx 45.55,6.5,30 --dem " + bundled_dem() +
+                                    " --radius-km 3 --heights 0:600:100 -o " + vdb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  scene::VolumeSpec v;
+  v.file = vdb;
+  v.isosurfaces = {volume::parse_isosurface("110")};
+  v.slices = {volume::parse_slice("agl=300")};
+  SceneRenderer sync(scene_spec({v}), small_settings(), options(Sliding::kSynchronous));
+  SceneRenderer async(scene_spec({v}), small_settings(), options(Sliding::kAsynchronous));
+  const std::size_t merged = sync.merge_figures().tree_triangles;
+  EXPECT_GT(merged, 0u);
+  ASSERT_EQ(sync.render(kNorth, true, 45.0, {}).slides, 1);
+  async.render(kNorth, true, 45.0, {});
+  ASSERT_TRUE(render_until_slid(async));
+  sync.render(kNorth, true, 45.0, {});
+  EXPECT_GT(sync.last_frame().indices.size(), 0u);
+  EXPECT_EQ(sync.terrain().tree().merged_colors(), async.terrain().tree().merged_colors());
+  expect_same_slide(sync, async);
+}
+
+}  // namespace
+}  // namespace terravol::app::render
