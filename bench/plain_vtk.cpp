@@ -25,6 +25,7 @@
 
 #include "app/render/terrain_renderer.h"
 #include "app/render/vtk_camera.h"
+#include "app/scene/timing.h"
 
 namespace terravol::bench {
 
@@ -202,11 +203,11 @@ void PlainVtkScene::set_camera(const mrbsp::Camera& camera, double far_plane) {
 }
 
 double PlainVtkScene::render() {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = app::scene::Clock::now();
   window_->Render();
   window_->WaitForCompletion();
   rendered_ = true;
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return app::scene::ms_since(t0);
 }
 
 bool PlainVtkScene::dual_depth_peeling() {

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/scene/timing.h"
+
 namespace terravol::bench {
 
 struct Summary {
@@ -42,9 +44,7 @@ inline nlohmann::json to_json(const Summary& s) {
   return {{"median", s.median}, {"p10", s.p10}, {"p90", s.p90}, {"min", s.min}, {"max", s.max}, {"n", s.n}};
 }
 
-using Clock = std::chrono::steady_clock;
-inline double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using app::scene::Clock;
+using app::scene::ms_since;
 
 }  // namespace terravol::bench

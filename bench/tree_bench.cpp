@@ -14,14 +14,15 @@
 #include <glm/geometric.hpp>
 
 #include "app/scene/terrain_scene.h"
+#include "app/scene/timing.h"
 #include "io/error.h"
 #include "io/mosaic.h"
 #include "io/void_fill.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+using terravol::app::scene::Clock;
+using terravol::app::scene::ms_since;
 
 struct Summary {
   double median, min, max;

@@ -38,6 +38,7 @@
 
 #include "app/render/ordered_mapper.h"
 #include "app/render/vtk_camera.h"
+#include "app/scene/timing.h"
 
 #include <X11/Xlib.h>
 
@@ -490,10 +491,10 @@ void TerrainRenderer::set_legend(const scene::Legend& legend) {
 }
 
 double TerrainRenderer::render() {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = scene::Clock::now();
   window_->Render();
   window_->WaitForCompletion();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return scene::ms_since(t0);
 }
 
 std::vector<std::uint8_t> TerrainRenderer::rgb() const { return window_rgb(window_); }

@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "app/scene/timing.h"
 #include "io/void_fill.h"
 
 namespace terravol::app::scene {
@@ -79,9 +80,9 @@ mrbsp::TerrainTree TerrainScene::build(TerrainScene& s, const io::Mosaic& mosaic
                                 " cells has 1.." + std::to_string(k + 1) + " levels");
   }
   const mrbsp::TerrainWindow tw = s.adopt(read_scene_window(mosaic, s.window_, s.frame_));
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   mrbsp::TerrainTree tree(tw, levels);
-  s.build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  s.build_ms_ = ms_since(t0);
   return tree;
 }
 

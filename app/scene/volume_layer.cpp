@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "app/scene/ground_grid.h"
+#include "app/scene/timing.h"
 #include "volume/colormap.h"
 #include "volume/geometry.h"
 #include "volume/readers.h"
@@ -15,12 +16,6 @@
 namespace terravol::app::scene {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 std::array<float, 2> finite_range(const volume::Volume& v) {
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
