@@ -70,7 +70,7 @@ vtkNew<vtkUnsignedCharArray> rgba_array(const void* data, std::size_t count) {
 
 // Colours as they are (no lookup table, no lighting): ambient 1, diffuse 0, specular 0 and
 // lighting off, so the fragment colour is the interpolated vertex colour, as in
-// app::TerrainRenderer.
+// app::render::TerrainRenderer.
 void setup_unlit(vtkPolyDataMapper& mapper, vtkActor& actor) {
   mapper.SetColorModeToDirectScalars();
   mapper.SetScalarModeToUsePointData();
@@ -135,7 +135,7 @@ PlainVtkScene::PlainVtkScene(std::span<const glm::vec3> terrain_positions,
   check_triangles(terrain_triangles, terrain_positions.size(), "terrain");
   check_triangles(overlay_triangles, overlay_positions.size(), "overlay");
 
-  // The terrain: float positions, as app::TerrainRenderer uploads them.
+  // The terrain: float positions, as app::render::TerrainRenderer uploads them.
   vtkNew<vtkFloatArray> xyz;
   xyz->SetNumberOfComponents(3);
   xyz->SetNumberOfTuples(static_cast<vtkIdType>(terrain_positions.size()));

@@ -63,9 +63,9 @@ std::vector<std::uint32_t> lattice_triangles(int cells);
 
 class PlainVtkScene {
  public:
-  // terrain: positions (scene frame, metres), per-vertex RGBA already shaded (app::TerrainShading
-  // rgba: drawn as they are, lighting off, like app::TerrainRenderer), index triples into the
-  // positions; drawn opaque (alpha ignored).
+  // terrain: positions (scene frame, metres), per-vertex RGBA already shaded
+  // (app::scene::TerrainShading rgba: drawn as they are, lighting off, like
+  // app::render::TerrainRenderer), index triples into the positions; drawn opaque (alpha ignored).
   // overlay: positions (scene frame, metres), per-vertex RGBA whose alpha is the opacity, index
   // triples; drawn translucent as options.translucency says, both faces, lighting off. May be
   // empty (no translucent actor then); so may the terrain.
@@ -83,9 +83,9 @@ class PlainVtkScene {
   PlainVtkScene(const PlainVtkScene&) = delete;
   PlainVtkScene& operator=(const PlainVtkScene&) = delete;
 
-  // The view, as app::TerrainRenderer sets it (app::apply_camera): clipping range
-  // [camera.near_plane, far_plane] metres. camera.width/height are not used: the image has
-  // the options' size.
+  // The view, as app::render::TerrainRenderer sets it (app::render::apply_camera): clipping
+  // range [camera.near_plane, far_plane] metres. camera.width/height are not used: the image
+  // has the options' size.
   void set_camera(const mrbsp::Camera& camera, double far_plane);
 
   // Draws one frame and waits for the GPU to finish it (WaitForCompletion: glFinish); returns

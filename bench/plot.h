@@ -40,7 +40,7 @@ std::array<std::uint8_t, 3> series_color(std::size_t index);
 // Throws std::invalid_argument when there is no series, a series is empty, its x and y differ in
 // length, a value is not finite, a value on a log axis is not positive, or the size is not
 // positive; std::runtime_error when no X display can be opened
-// (terravol::app::require_x_display) or the file cannot be written.
+// (terravol::app::render::require_x_display) or the file cannot be written.
 void write_chart_png(const std::filesystem::path& path, const ChartSpec& spec);
 
 }  // namespace terravol::bench

@@ -87,7 +87,8 @@ std::string keys_around(const std::vector<scene::PathKey>& keys, double t) {
 void run_fly(const FlyOptions& o) {
   const std::string source = o.path.string();
   const scene::CameraPathFile file = scene::load_camera_path(o.path);
-  scene::SceneSpec scene = file.scene_file.empty() ? scene::parse_scene_json(file.scene, file.base_dir, source + ": scene")
+  scene::SceneSpec scene = file.scene_file.empty()
+                               ? scene::parse_scene_json(file.scene, file.base_dir, source + ": scene")
                                             : scene::load_scene_file(file.scene_file);
   if (scene.dems.empty()) throw std::invalid_argument(source + ": scene: no \"dem\"; the flight needs terrain");
   for (const auto& d : scene.dems) {

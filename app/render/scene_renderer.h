@@ -82,7 +82,8 @@ class SceneRenderer {
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   // Renders the view of `pose` (alt above the ground when agl): prepare(), then draw().
-  FrameStats render(const scene::CameraPose& pose, bool agl, double fov_y_deg, const mrbsp::TraversalOptions& traversal);
+  FrameStats render(const scene::CameraPose& pose, bool agl, double fov_y_deg,
+                    const mrbsp::TraversalOptions& traversal);
   // Everything of a frame but the draw: slides the window first (see Sliding) when auto-slide is
   // on and the camera is within a quarter of the window's side of an edge, sets the camera (the
   // window's current size in pixels) and the sky, traverses the tree and replaces the triangle
@@ -152,9 +153,9 @@ class SceneRenderer {
   void upload_vertices();
   void slide(const scene::CameraPose& pose, FrameStats& stats);
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
-  static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex, const scene::WindowChoice& next,
-                                     const io::SceneFrame& frame, const scene::ShadingOptions& shading,
-                                     std::size_t terrain_vertices);
+  static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
+                                     const scene::WindowChoice& next, const io::SceneFrame& frame,
+                                     const scene::ShadingOptions& shading, std::size_t terrain_vertices);
   void finish_slide(PreparedSlide&& prepared);
 
   io::Mosaic mosaic_;

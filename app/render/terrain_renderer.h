@@ -142,7 +142,9 @@ class TerrainRenderer {
  private:
   void apply_color_mode();
   void install_shaders(vtkActor& actor, bool textured);
-  bool split_orders() const { return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer; }
+  bool split_orders() const {
+    return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer;
+  }
 
   RenderSettings settings_;
   std::vector<float> shade_;      // per vertex, for --lod-colors

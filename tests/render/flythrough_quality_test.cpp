@@ -45,7 +45,8 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
   const scene::WindowChoice window = scene::choose_window(mosaic.rows(), mosaic.cols(), 600.0, 600.0, 1024);
   const scene::TerrainScene scene(mosaic, window, scene::default_levels(window.cells));
   const mrbsp::TerrainTree& tree = scene.tree();
-  const scene::TerrainShading lattice = scene::shade_terrain(scene.cells(), scene.xs(), scene.ys(), scene.z(), scene.heights(), {});
+  const scene::TerrainShading lattice =
+      scene::shade_terrain(scene.cells(), scene.xs(), scene.ys(), scene.z(), scene.heights(), {});
   const scene::TerrainShading shading = scene::vertex_shading(lattice, tree.merged_base(), tree.merged_colors());
   RenderSettings settings;
   settings.gradient = false;  // one background colour for every view
@@ -67,7 +68,8 @@ TEST(FlythroughQuality, DefaultThresholdDrawsTwentyTimesFewerTrianglesAt35DbOver
     const double ground = scene.ground_height(pose.lat, pose.lon);
     const double clearance = overview ? 8000.0 : 600.0 + 1900.0 * std::abs(std::cos(1.3 * k));
     const mrbsp::Camera camera =
-        scene::make_scene_camera(scene.frame(), pose, ground + clearance, 45.0, settings.width, settings.height, scene::near_plane_for(clearance));
+        scene::make_scene_camera(scene.frame(), pose, ground + clearance, 45.0, settings.width, settings.height,
+                                 scene::near_plane_for(clearance));
     renderer.set_camera(camera, 200000.0);
 
     mrbsp::TraversalOptions lod;

@@ -73,7 +73,8 @@ test::Rgb8 centre_pixel(const TwoSquares& s, scene::DrawOrder order, const std::
 TEST(TerrainRenderer, BspOrderDrawsLaterTrianglesOnTopWithoutDepthTest) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
-  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, kNearThenFar), (test::Rgb8{0, 0, 255})) << "the far square, drawn last";
+  EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, kNearThenFar), (test::Rgb8{0, 0, 255}))
+      << "the far square, drawn last";
   EXPECT_EQ(centre_pixel(s, scene::DrawOrder::kBsp, kFarThenNear), (test::Rgb8{255, 0, 0}));
 }
 
