@@ -130,13 +130,13 @@ std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::Camer
   return next;
 }
 
-// Reads `next` from the mosaic (under its lock) in `frame` and shades it; with
-// terrain_vertices > 0 (a tree without merged polygons, whose vertices are the lattice's and the
-// skirts'), also the vertices' shading. Touches nothing of the pipeline, so it may run on a
-// worker thread while the pipeline draws.
+// Reads `next` from the mosaic (under its lock) in `frame`; with `shading`, shades it too and,
+// with terrain_vertices > 0 (a tree without merged polygons, whose vertices are the lattice's
+// and the skirts'), makes the vertices' shading. Touches nothing of the pipeline, so it may run
+// on a worker thread while the pipeline draws.
 SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
                                                           const scene::WindowChoice& next, const io::SceneFrame& frame,
-                                                          const scene::ShadingOptions& shading,
+                                                          const std::optional<scene::ShadingOptions>& shading,
                                                           std::size_t terrain_vertices) {
   PreparedSlide p;
   const auto t0 = Clock::now();
@@ -145,13 +145,17 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
     p.window = scene::read_scene_window(mosaic, next, frame);
   }
   const auto t1 = Clock::now();
-  p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, shading);
-  if (terrain_vertices > 0) p.vertices = scene::vertex_shading(p.lattice, terrain_vertices, {});
+  if (shading) {
+    p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, *shading);
+    if (terrain_vertices > 0) p.vertices = scene::vertex_shading(p.lattice, terrain_vertices, {});
+    p.shade_ms = ms_since(t1);
+  }
   p.read_ms = ms_between(t0, t1);
-  p.shade_ms = ms_since(t1);
   return p;
 }
 
+// What prepare_slide left out (with kSynchronous: the shading, so that it is made after the old
+// vertices and the merge's scratch are gone, not held across the merge) is made here.
 void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const auto t0 = Clock::now();
   // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
@@ -164,6 +168,13 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     throw;
   }
   return_freed_memory();  // the old vertices and the merge's scratch
+  const double tree_ms = ms_since(t0);
+  if (p.lattice.rgba.empty()) {
+    const auto s0 = Clock::now();
+    p.lattice = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
+                                     options_.shading);
+    p.shade_ms = ms_since(s0);
+  }
   lattice_ = std::move(p.lattice);
   const auto t1 = Clock::now();
   const mrbsp::TerrainTree& tree = scene_->tree();
@@ -171,7 +182,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
   p.vertices = {};
   return_freed_memory();  // the upload's shading copies
-  last_slide_ = {p.read_ms, p.shade_ms, ms_between(t0, t1), ms_since(t1)};
+  last_slide_ = {p.read_ms, p.shade_ms, tree_ms, ms_since(t1)};
   ++slides_;
 }
 
@@ -184,27 +195,30 @@ std::optional<std::string> SceneRenderer::take_slide_error() { return std::excha
 void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
   const auto t0 = Clock::now();
   bool slid = false;
-  // Without volumes the tree has no merged vertices, before the slide or after it: the
-  // vertices' shading can be made with the lattice's.
-  const std::size_t terrain_vertices = volumes_.size() == 0 ? scene_->tree().merged_base() : 0;
   if (options_.sliding == Sliding::kSynchronous) {
     if (const auto next = auto_slide_ ? next_window(pose) : std::nullopt) {
-      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame(), options_.shading, terrain_vertices));
+      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame(), std::nullopt, 0));
       slid = true;
     }
   } else {
     if (slide_ready()) {
+      std::optional<PreparedSlide> p;
       try {
-        PreparedSlide p = pending_.get();
-        finish_slide(std::move(p));
-        slid = true;
+        p = pending_.get();
       } catch (const io::FormatError& e) {
         slide_error_ = e.what();
         auto_slide_ = false;
       }
+      if (p) {
+        finish_slide(std::move(*p));
+        slid = true;
+      }
     }
     if (auto_slide_ && !pending_.valid()) {
       if (const auto next = next_window(pose)) {
+        // Without volumes the tree has no merged vertices, before the slide or after it: the
+        // worker can make the vertices' shading with the lattice's.
+        const std::size_t terrain_vertices = volumes_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
           return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);

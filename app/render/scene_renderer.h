@@ -61,7 +61,8 @@ RenderSettings render_settings(const scene::Style& style);
 
 // The last slide's parts, milliseconds.
 struct SlideFigures {
-  double read_ms = 0, shade_ms = 0;     // reading the moved window and shading it (kAsynchronous: off thread)
+  double read_ms = 0;   // reading the moved window (kAsynchronous: on the worker thread)
+  double shade_ms = 0;  // shading it (kAsynchronous: on the worker; kSynchronous: after the tree)
   double tree_ms = 0, vertices_ms = 0;  // sliding the tree (merging again), replacing the renderer's vertices
 };
 
@@ -143,11 +144,11 @@ class SceneRenderer {
   const scene::MergeFigures& remerge();
 
  private:
-  // A moved window read from the mosaic and shaded, ready to slide to.
+  // A moved window read from the mosaic (and, read ahead, shaded), ready to slide to.
   struct PreparedSlide {
     scene::SceneWindow window;
-    scene::TerrainShading lattice;
-    scene::TerrainShading vertices;  // of a tree without merged polygons; else empty (made after the slide)
+    scene::TerrainShading lattice;   // empty: made after the slide
+    scene::TerrainShading vertices;  // of a tree without merged polygons; empty: made after the slide
     double read_ms = 0, shade_ms = 0;
   };
   void upload_vertices();
@@ -155,7 +156,8 @@ class SceneRenderer {
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
   static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
                                      const scene::WindowChoice& next, const io::SceneFrame& frame,
-                                     const scene::ShadingOptions& shading, std::size_t terrain_vertices);
+                                     const std::optional<scene::ShadingOptions>& shading,
+                                     std::size_t terrain_vertices);
   void finish_slide(PreparedSlide&& prepared);
 
   io::Mosaic mosaic_;

@@ -316,6 +316,14 @@ double differing_rows(const test::Image& a, const test::Image& b, int y0, int y1
   return total == 0 ? 0.0 : static_cast<double>(differ) / static_cast<double>(total);
 }
 
+// A small path-loss volume over the bundled DEM (5 km around 45.5 N, 6.5 E), by terravol rf.
+::testing::AssertionResult make_volume(const std::filesystem::path& vdb) {
+  const auto r = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
+                                    " --radius-km 5 --heights 0:1000:100 -o " + vdb.string());
+  if (r.status == 0) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "terravol rf: " << r.err;
+}
+
 TEST(ViewCli, ForwardFliesAlongTheViewAtTheHeightScaledSpeedAndBackReturns) {
   TERRAVOL_REQUIRE_XDOTOOL();
   Viewer v(bundled_dem() + " --camera 45.5,6.5,4500,30,-20" + kSmall);
@@ -572,9 +580,7 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
   TERRAVOL_REQUIRE_XDOTOOL();
   test::TempDir dir;
   const auto vdb = dir.path() / "rf.vdb";
-  const auto r = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
-                                    " --radius-km 5 --heights 0:1000:100 -o " + vdb.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(make_volume(vdb));
   Viewer v(bundled_dem() + " --camera 45.44,6.44,2600,40,-18 --volume " + vdb.string() +
            " --iso 110 --slice agl=300" + kSmall);
   ASSERT_TRUE(v.start());
@@ -613,9 +619,7 @@ TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceAndSliceFromTheOptionOrTheSce
   TERRAVOL_REQUIRE_XDOTOOL();
   test::TempDir dir;
   const auto vdb = dir.path() / "rf.vdb";
-  const auto r = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
-                                    " --radius-km 5 --heights 0:1000:100 -o " + vdb.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(make_volume(vdb));
   const auto scene = dir.path() / "scene.json";
   std::ofstream(scene) << R"({"dem": ")" << bundled_dem() << R"(", "volumes": [{"file": ")" << vdb.string()
                        << R"(", "isosurfaces": [{"value": 110}], "slices": [{"agl": 300}]}],
