@@ -392,8 +392,8 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
 json build_suite(const BenchConfig& c, const Terrain& terrain) {
   say(c, "build " + terrain.name + ": build and slide of a 1024-cell window");
   const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
-  const app::scene::WindowChoice w0 = app::scene::choose_window(mosaic.rows(), mosaic.cols(), (mosaic.rows() - 1) / 2.0,
-                                                  (mosaic.cols() - 1) / 2.0, 1024);
+  const app::scene::WindowChoice w0 = app::scene::choose_window(mosaic.rows(), mosaic.cols(),
+                                                                (mosaic.rows() - 1) / 2.0, (mosaic.cols() - 1) / 2.0, 1024);
   const int levels = app::scene::default_levels(w0.cells);
   app::scene::WindowChoice w1 = w0;
   w1.col0 += 1 << (levels - 1);  // one coarsest cell east

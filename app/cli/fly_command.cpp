@@ -89,7 +89,7 @@ void run_fly(const FlyOptions& o) {
   const scene::CameraPathFile file = scene::load_camera_path(o.path);
   scene::SceneSpec scene = file.scene_file.empty()
                                ? scene::parse_scene_json(file.scene, file.base_dir, source + ": scene")
-                                            : scene::load_scene_file(file.scene_file);
+                               : scene::load_scene_file(file.scene_file);
   if (scene.dems.empty()) throw std::invalid_argument(source + ": scene: no \"dem\"; the flight needs terrain");
   for (const auto& d : scene.dems) {
     if (!std::filesystem::exists(d)) throw std::invalid_argument(source + ": scene: " + d.string() + ": no such file");
@@ -218,9 +218,9 @@ void run_fly(const FlyOptions& o) {
   settings.height = height * factor;
   render::SceneRenderer renderer(std::move(mosaic), scene, settings, render::scene_options(st));
 
-  const scene::CameraPath path(file.keys, renderer.frame(),
-                        [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); }, file.speed,
-                        default_fov, default_threshold);
+  const scene::CameraPath path(
+      file.keys, renderer.frame(), [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); },
+      file.speed, default_fov, default_threshold);
   const auto time_of = [&](long k) { return t0 + static_cast<double>(k) / o.fps; };
 
   // Every frame's camera, checked before the first is drawn.

@@ -190,7 +190,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     for (std::size_t n = 0; n < r.ano_texts.size(); ++n) {
       const std::string& text = r.ano_texts[n];
       output::write_file_atomically(ano_name(o.ano_dir, heights[n]),
-                            std::vector<std::uint8_t>(text.begin(), text.end()), o.force);
+                                    std::vector<std::uint8_t>(text.begin(), text.end()), o.force);
     }
   }
   if (site) {
