@@ -175,7 +175,7 @@ class Viewer {
   Clock::time_point start_, last_tick_;
 
   // Figures.
-  std::size_t frames_ = 0, screenshots_ = 0;
+  std::size_t frames_ = 0, screenshots_ = 0, key_presses_ = 0;
   double frame_ms_ = 0, traversal_ms_ = 0, upload_ms_ = 0, draw_ms_ = 0;
   std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;  // slide_log_: this thread's part
   std::filesystem::path last_screenshot_;
@@ -409,6 +409,7 @@ scene::FlightInput Viewer::input() const {
 }
 
 void Viewer::key_press(const std::string& key) {
+  ++key_presses_;
   static const std::set<std::string> kMotion{"w",  "s",    "a",    "d",     "r",       "f",      "Prior",
                                              "Next", "Up", "Down", "Left", "Right", "Shift_L", "Shift_R"};
   if (kMotion.count(key) > 0) {
@@ -770,6 +771,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                  {"eye", {camera.eye.x, camera.eye.y, camera.eye.z}}};
   j["speed_mps"] = speed;
   j["keys_held"] = held_;
+  j["key_presses"] = key_presses_;  // handled so far, bound or not
   j["frame_ms"] = frame_ms_;
   j["traversal_ms"] = traversal_ms_;
   j["upload_ms"] = upload_ms_;

@@ -215,10 +215,12 @@ class Viewer {
     const int rc = shell("xdotool " + args, &out);
     EXPECT_EQ(rc, 0) << "xdotool " << args << ": " << out;
   }
+  // Taps a bound key and waits for the first frame drawn after the viewer handled it (a frame
+  // that merely follows the tap may have been asked for before it).
   void tap(const std::string& key) {
-    const int before = status().value("frame", 0);
+    const int before = status().value("key_presses", 0);
     xdo("key " + key);
-    wait_for([&](const json& s) { return s["frame"].get<int>() > before; }, 10.0);
+    wait_for([&](const json& s) { return s.value("key_presses", 0) > before; }, 10.0);
   }
   void key_down(const std::string& key) {
     xdo("keydown " + key);
