@@ -35,36 +35,29 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
   s.sun_azimuth = defaults.shading.sun_azimuth_deg;
   s.sun_elevation = defaults.shading.sun_elevation_deg;
   s.surface_triangles = defaults.surface_triangles;
-  s.size_option =
-      cmd.add_option("--size", s.size, "Image (view: window) size WIDTHxHEIGHT, pixels")->capture_default_str();
-  s.metric_option = cmd.add_option("--lod-metric", s.metric,
-                                   "LOD metric: error (screen-space error) or area (the paper's); in view, "
-                                   "key M switches")
-                        ->capture_default_str();
+  // Each shows its default (the values just set) in --help.
+  const auto option = [&cmd](const char* name, auto& value, const char* help) {
+    return cmd.add_option(name, value, help)->capture_default_str();
+  };
+  s.size_option = option("--size", s.size, "Image (view: window) size WIDTHxHEIGHT, pixels");
+  s.metric_option = option("--lod-metric", s.metric,
+                           "LOD metric: error (screen-space error) or area (the paper's); in view, key M switches");
   s.threshold_option = cmd.add_option("--threshold", s.threshold,
                                       "LOD threshold: pixels of screen-space error (default 2) or, with --lod-metric "
                                       "area, projected box area in square pixels (default 500)");
-  s.window_option =
-      cmd.add_option("--window", s.window, "Largest window side, cells (a power of two)")->capture_default_str();
-  s.order_option = cmd.add_option("--order", s.order,
-                                  "bsp (tree order, no depth test), zbuffer (the same order, depth-tested), and for "
-                                  "translucent volumes the references: peel (VTK depth peeling, unlimited peels: "
-                                  "exact), vtk (VTK's default alpha blending, unsorted), sort (vtkDepthSortPolyData)")
-                       ->capture_default_str();
-  s.sun_azimuth_option = cmd.add_option("--sun-azimuth", s.sun_azimuth, "Sun direction, degrees clockwise from north")
-                             ->capture_default_str();
-  s.sun_elevation_option =
-      cmd.add_option("--sun-elevation", s.sun_elevation, "Sun elevation, degrees")->capture_default_str();
-  s.haze_option = cmd.add_option("--haze", s.haze_km,
-                                 "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; "
-                                 "0: none")
-                      ->capture_default_str();
-  s.tint_option = cmd.add_option("--tint", s.tint, "Terrain tint: atlas, relative (stretched to the window) or grey")
-                      ->capture_default_str();
-  s.surface_option = cmd.add_option("--surface-triangles", s.surface_triangles,
-                                    "Decimate each isosurface and slice to at most this many triangles before merging "
-                                    "(0: keep all)")
-                         ->capture_default_str();
+  s.window_option = option("--window", s.window, "Largest window side, cells (a power of two)");
+  s.order_option = option("--order", s.order,
+                          "bsp (tree order, no depth test), zbuffer (the same order, depth-tested), and for "
+                          "translucent volumes the references: peel (VTK depth peeling, unlimited peels: exact), "
+                          "vtk (VTK's default alpha blending, unsorted), sort (vtkDepthSortPolyData)");
+  s.sun_azimuth_option = option("--sun-azimuth", s.sun_azimuth, "Sun direction, degrees clockwise from north");
+  s.sun_elevation_option = option("--sun-elevation", s.sun_elevation, "Sun elevation, degrees");
+  s.haze_option = option("--haze", s.haze_km,
+                         "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; 0: none");
+  s.tint_option = option("--tint", s.tint, "Terrain tint: atlas, relative (stretched to the window) or grey");
+  s.surface_option = option("--surface-triangles", s.surface_triangles,
+                            "Decimate each isosurface and slice to at most this many triangles before merging "
+                            "(0: keep all)");
 }
 
 scene::SceneStyle given_style(const SceneArgs& args) {
