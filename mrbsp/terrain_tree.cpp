@@ -6,14 +6,17 @@
 //     grid lines of the coarsest level still available, alternating longitude and latitude to
 //     keep regions square; where a region is one cell of that level, an alternative list of
 //     two: the cell's two triangles (low) and the same region rebuilt from the next level (high);
-//   - section 4.3: sliding. Nodes refer to lattice line indices, never to data, so moving the
-//     window over the terrain only recomputes plane offsets, positions, boxes and errors
-//     (refresh()); the node structure is built once;
+//   - section 4.3: sliding. The topology depends only on the window's size, so moving the
+//     window over the terrain only recomputes plane offsets, positions, z ranges and errors
+//     (refresh()); nothing of the structure is rebuilt;
 //   - sections 5, 5.1 and figure 5: the draw order (far child, node polygons, near child) and
 //     the LOD choice from the projected bounding box; a second metric, the screen-space error.
 //
 // Departures from the paper, and why:
-//   - The traversal is an explicit stack over flat node arrays (no recursion, no pointers).
+//   - No node is stored: a region is a cell (level, ci, cj) and its split planes are its
+//     middle lattice lines (mrbsp/tree_impl.h), so the tree is a function of the window's
+//     size. Per cell the tree keeps only its z range and error (CellZ); the traversal is an
+//     explicit stack of implicit node names (no recursion, no pointers).
 //   - The paper leaves cracks between neighbours at different levels unaddressed; there is no
 //     depth buffer to hide them here, so they are filled with skirts: vertical quads in the
 //     shared boundary plane, emitted only where the neighbour cell at the same level was not
@@ -27,12 +30,15 @@
 //     so only those are drawn; below the ground only the others; near it, both.
 //   - Inside a cell the two triangles are ordered by the vertical plane through the cell's
 //     diagonal, which separates them.
+//   - Merged polygons (merge.cpp) live in small BSPs at cells ("slots"); each region's culling
+//     box holds them as well as its terrain.
 #include "mrbsp/terrain_tree.h"
 
 #include "mrbsp/tree_impl.h"
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -47,30 +53,12 @@
 
 namespace terravol::mrbsp {
 
-std::int32_t TerrainTree::Impl::build_region(int rx, int ry, int w, int h, int level) {
-  const int s = cell_size(level);
-  const auto index = static_cast<std::int32_t>(nodes.size());
-  nodes.emplace_back();
-  if (w == s && h == s) {
-    nodes[index].kind = kCell;
-    nodes[index].level = static_cast<std::uint8_t>(level);
-    nodes[index].cell = cell_id(level, rx / s, ry / s);
-    if (level + 1 < levels) {
-      const std::int32_t high = build_region(rx, ry, s, s, level + 1);
-      nodes[index].child[0] = high;
-    }
-    return index;
+CellZ TerrainTree::Impl::cell_z(int level, int ci, int cj) const {
+  if (level == levels - 1) {
+    const float a = z(ci, cj), b = z(ci + 1, cj), c = z(ci, cj + 1), d = z(ci + 1, cj + 1);
+    return {std::min(std::min(a, b), std::min(c, d)), std::max(std::max(a, b), std::max(c, d)), 0.0f};
   }
-  // Split at the middle grid line of this level, the longer side first (x when square).
-  const bool split_x = w >= h;
-  const int line = split_x ? rx + w / 2 : ry + h / 2;
-  nodes[index].kind = split_x ? kSplitX : kSplitY;
-  nodes[index].line = line;
-  const std::int32_t a = split_x ? build_region(rx, ry, w / 2, h, level) : build_region(rx, ry, w, h / 2, level);
-  const std::int32_t b = split_x ? build_region(line, ry, w / 2, h, level) : build_region(rx, line, w, h / 2, level);
-  nodes[index].child[0] = a;
-  nodes[index].child[1] = b;
-  return index;
+  return cellz[static_cast<std::size_t>(level + top)][static_cast<std::size_t>(cj * cells_at(level) + ci)];
 }
 
 void TerrainTree::Impl::refresh(const TerrainWindow& w) {
@@ -86,27 +74,27 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   }
   xs.assign(w.xs.begin(), w.xs.end());
   ys.assign(w.ys.begin(), w.ys.end());
-  const auto z = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
+  const auto zw = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
   // Skirt bottoms. Every level's polyline along a lattice line, inside one level-0 edge
   // segment, interpolates samples of that segment; so a skirt under an edge on row j
   // reaches low enough at the lowest sample of row j within the level-0 segment(s) holding
   // the edge, minus 1 m. Two bottoms per sample: one for edges along its row (south and
   // north skirts), one for edges along its column (west and east skirts).
-  const int s0 = cell_size(0);
+  const int s0 = cell_size(0), c0 = cells_at(0);
   const std::size_t count = side * side;
   positions.resize(3 * count);
-  std::vector<float> segment_min(static_cast<std::size_t>(level_cells[0]));
+  std::vector<float> segment_min(static_cast<std::size_t>(c0));
   for (int pass = 0; pass < 2; ++pass) {  // 0: along rows, 1: along columns
     for (int line = 0; line <= n; ++line) {
-      const auto at = [&](int k) { return pass == 0 ? z(k, line) : z(line, k); };
-      for (int seg = 0; seg < level_cells[0]; ++seg) {
+      const auto at = [&](int k) { return pass == 0 ? zw(k, line) : zw(line, k); };
+      for (int seg = 0; seg < c0; ++seg) {
         float mn = at(seg * s0);
         for (int k = seg * s0 + 1; k <= (seg + 1) * s0; ++k) mn = std::min(mn, at(k));
         segment_min[static_cast<std::size_t>(seg)] = mn;
       }
       for (int k = 0; k <= n; ++k) {
-        float bottom = segment_min[static_cast<std::size_t>(std::min(k / s0, level_cells[0] - 1))];
+        float bottom = segment_min[static_cast<std::size_t>(std::min(k / s0, c0 - 1))];
         if (k % s0 == 0 && k > 0) bottom = std::min(bottom, segment_min[static_cast<std::size_t>(k / s0 - 1)]);
         const int i = pass == 0 ? k : line, j = pass == 0 ? line : k;
         const std::size_t v = vertex(i, j);
@@ -115,60 +103,62 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
     }
   }
   for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), z(i, j));
+    for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), zw(i, j));
 
-  // Cells: box and error from their samples, independent of each other (TBB).
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t k = range.begin(); k != range.end(); ++k) {
-      Node& node = nodes[k];
-      if (node.kind != kCell) continue;
-      const int level = node.level;
-      const int s = cell_size(level);
-      const std::uint32_t local = node.cell - level_offset[level];
-      const int ci = static_cast<int>(local % static_cast<std::uint32_t>(level_cells[level]));
-      const int cj = static_cast<int>(local / static_cast<std::uint32_t>(level_cells[level]));
-      const int i0 = ci * s, j0 = cj * s;
-      const float zsw = z(i0, j0), zse = z(i0 + s, j0), zne = z(i0 + s, j0 + s), znw = z(i0, j0 + s);
-      float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
-      const float inv = 1.0f / static_cast<float>(s);
-      for (int j = 0; j <= s; ++j) {
-        const float v = static_cast<float>(j) * inv;
-        for (int i = 0; i <= s; ++i) {
-          const float h = z(i0 + i, j0 + j);
-          zmin = std::min(zmin, h);
-          zmax = std::max(zmax, h);
-          const float u = static_cast<float>(i) * inv;
-          const float approx = u >= v ? zsw + u * (zse - zsw) + v * (zne - zse) : zsw + v * (znw - zsw) + u * (zne - znw);
-          err = std::max(err, std::abs(h - approx));
+  // LOD cells above the finest: z range and error from their samples, independent of each
+  // other (TBB over the cells of each level).
+  for (int level = 0; level + 1 < levels; ++level) {
+    const int s = cell_size(level), c = cells_at(level);
+    std::vector<CellZ>& out = cellz[static_cast<std::size_t>(level + top)];
+    tbb::parallel_for(tbb::blocked_range<int>(0, c * c, 64), [&](const tbb::blocked_range<int>& range) {
+      for (int k = range.begin(); k != range.end(); ++k) {
+        const int i0 = (k % c) * s, j0 = (k / c) * s;
+        const float zsw = zw(i0, j0), zse = zw(i0 + s, j0), zne = zw(i0 + s, j0 + s), znw = zw(i0, j0 + s);
+        float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
+        const float inv = 1.0f / static_cast<float>(s);
+        for (int j = 0; j <= s; ++j) {
+          const float v = static_cast<float>(j) * inv;
+          for (int i = 0; i <= s; ++i) {
+            const float h = zw(i0 + i, j0 + j);
+            zmin = std::min(zmin, h);
+            zmax = std::max(zmax, h);
+            const float u = static_cast<float>(i) * inv;
+            const float approx = u >= v ? zsw + u * (zse - zsw) + v * (zne - zse) : zsw + v * (znw - zsw) + u * (zne - znw);
+            err = std::max(err, std::abs(h - approx));
+          }
         }
+        out[static_cast<std::size_t>(k)] = {zmin, zmax, err};
       }
-      node.error = err;
-      node.lo = glm::vec3(static_cast<float>(xs[static_cast<std::size_t>(i0)]), static_cast<float>(ys[static_cast<std::size_t>(j0)]), zmin);
-      node.hi = glm::vec3(static_cast<float>(xs[static_cast<std::size_t>(i0 + s)]), static_cast<float>(ys[static_cast<std::size_t>(j0 + s)]), zmax);
-    }
-  });
-  // Split nodes: plane offsets and boxes from their children (pre-order: reverse index order).
-  for (std::size_t k = nodes.size(); k-- > 0;) {
-    Node& node = nodes[k];
-    if (node.kind == kCell) continue;
-    node.plane = static_cast<float>(node.kind == kSplitX ? xs[static_cast<std::size_t>(node.line)] : ys[static_cast<std::size_t>(node.line)]);
-    const Node& a = nodes[static_cast<std::size_t>(node.child[0])];
-    const Node& b = nodes[static_cast<std::size_t>(node.child[1])];
-    node.lo = glm::min(a.lo, b.lo);
-    node.hi = glm::max(a.hi, b.hi);
+    });
+  }
+  // Top levels: the union of their four children.
+  for (int level = -1; level >= -top; --level) {
+    const int c = cells_at(level);
+    std::vector<CellZ>& out = cellz[static_cast<std::size_t>(level + top)];
+    for (int cj = 0; cj < c; ++cj)
+      for (int ci = 0; ci < c; ++ci) {
+        CellZ u{std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(), 0.0f};
+        for (int b = 0; b < 2; ++b)
+          for (int a = 0; a < 2; ++a) {
+            const CellZ ch = cell_z(level + 1, 2 * ci + a, 2 * cj + b);
+            u.zmin = std::min(u.zmin, ch.zmin);
+            u.zmax = std::max(u.zmax, ch.zmax);
+          }
+        out[static_cast<std::size_t>(cj * c + ci)] = u;
+      }
   }
   // The largest error of any alternative inside each level-0 cell (for the skirt choice).
-  level0_error.assign(static_cast<std::size_t>(level_cells[0]) * static_cast<std::size_t>(level_cells[0]), 0.0f);
-  for (const Node& node : nodes) {
-    if (node.kind != kCell) continue;
-    const int s = cell_size(node.level);
-    const std::uint32_t local = node.cell - level_offset[node.level];
-    const int ci = static_cast<int>(local % static_cast<std::uint32_t>(level_cells[node.level])) * s / s0;
-    const int cj = static_cast<int>(local / static_cast<std::uint32_t>(level_cells[node.level])) * s / s0;
-    float& e0 = level0_error[static_cast<std::size_t>(cj * level_cells[0] + ci)];
-    e0 = std::max(e0, node.error);
+  level0_error.assign(static_cast<std::size_t>(c0) * static_cast<std::size_t>(c0), 0.0f);
+  for (int level = 0; level + 1 < levels; ++level) {
+    const int c = cells_at(level), per = c / c0;
+    const std::vector<CellZ>& cz = cellz[static_cast<std::size_t>(level + top)];
+    for (int cj = 0; cj < c; ++cj)
+      for (int ci = 0; ci < c; ++ci) {
+        float& e0 = level0_error[static_cast<std::size_t>((cj / per) * c0 + ci / per)];
+        e0 = std::max(e0, cz[static_cast<std::size_t>(cj * c + ci)].error);
+      }
   }
-  merge();  // section 4.3: other objects are merged again into the moved tree
+  redistribute_all();  // section 4.3: other objects are merged again into the moved tree
 }
 
 TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::make_unique<Impl>()) {
@@ -176,31 +166,22 @@ TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::m
   if (n < 2 || (n & (n - 1)) != 0 || n > (1 << 15)) {
     throw std::invalid_argument("TerrainTree: cells per side must be a power of two in [2, 32768], is " + std::to_string(n));
   }
-  int k = 0;
-  while ((1 << k) < n) ++k;
+  const int k = std::countr_zero(static_cast<unsigned>(n));
   if (levels < 1 || levels > k + 1) {
     throw std::invalid_argument("TerrainTree: levels must be in [1, " + std::to_string(k + 1) + "], is " + std::to_string(levels));
   }
   Impl& m = *impl_;
   m.n = n;
   m.levels = levels;
+  m.top = k - (levels - 1);  // level 0 has 2^top cells per side
   std::uint32_t offset = 0;
   for (int l = 0; l < levels; ++l) {
     m.level_offset.push_back(offset);
-    m.level_cells.push_back(n / m.cell_size(l));
-    offset += static_cast<std::uint32_t>(m.level_cells[l]) * static_cast<std::uint32_t>(m.level_cells[l]);
+    offset += static_cast<std::uint32_t>(m.cells_at(l)) * static_cast<std::uint32_t>(m.cells_at(l));
   }
   m.total_cells = offset;
-  // Exactly the nodes build_region makes: a cell node per cell of every level; the c0 x c0
-  // level-0 cells need c0^2 - 1 split nodes above them, and each cell with a finer level below
-  // splits its high alternative into 2 x 2 cells with 3 more.
-  const std::size_t c0 = static_cast<std::size_t>(m.level_cells[0]);
-  const std::size_t finest = static_cast<std::size_t>(m.level_cells[levels - 1]) * static_cast<std::size_t>(m.level_cells[levels - 1]);
-  const std::size_t node_count = offset + (c0 * c0 - 1) + 3 * (offset - finest);
-  m.nodes.reserve(node_count);
-  m.build_region(0, 0, n, n, 0);
-  if (m.nodes.size() != node_count) {
-    throw std::logic_error("TerrainTree: built " + std::to_string(m.nodes.size()) + " nodes, expected " + std::to_string(node_count));
+  for (int l = -m.top; l + 1 < levels; ++l) {
+    m.cellz.emplace_back(static_cast<std::size_t>(m.cells_at(l)) * static_cast<std::size_t>(m.cells_at(l)));
   }
   m.refresh(window);
 }
@@ -223,17 +204,28 @@ std::size_t held(const std::vector<T>& v) {
 
 }  // namespace
 
+std::size_t BspStore::bytes() const {
+  return held(nodes) + held(polys) + held(refs) + held(positions) + held(colors);
+}
+
+std::size_t SurfacePieces::bytes() const {
+  return held(triangles) + held(vertices) + held(colors) + held(pieces) + held(refs);
+}
+
 MemoryStats TerrainTree::memory() const {
   const Impl& m = *impl_;
   MemoryStats s;
   s.samples = m.lattice_count();
-  s.nodes = held(m.nodes) + held(m.level_offset) + held(m.level_cells) + held(m.level0_error) + held(m.xs) + held(m.ys);
+  s.nodes = held(m.level_offset) + held(m.level0_error) + held(m.xs) + held(m.ys) + held(m.cellz);
+  for (const auto& level : m.cellz) s.nodes += held(level);
   // positions holds both: the terrain's blocks up to merged_base(), merged vertices after.
   const std::size_t terrain = std::min<std::size_t>(m.merged_base(), m.positions.capacity());
   s.vertices = terrain * sizeof(glm::vec3);
-  s.merged = held(m.positions) - s.vertices + held(m.merge_input_positions) + held(m.merge_input_colors) +
-             held(m.merge_input_triangles) + held(m.merged_colors) + held(m.polygons) + held(m.poly_vertices) +
-             held(m.node_polys) + held(m.extras) + held(m.leaf_nodes) + held(m.leaf_polys);
+  s.merged = held(m.positions) - s.vertices + held(m.merged_colors) + held(m.surfaces) + held(m.slots) +
+             held(m.content_index) + held(m.content) + held(m.top_content);
+  for (const auto& [id, surface] : m.surfaces) s.merged += surface.bytes();
+  for (const Slot& slot : m.slots) s.merged += slot.store.bytes();
+  for (const auto& level : m.top_content) s.merged += held(level);
   return s;
 }
 
@@ -243,9 +235,6 @@ struct Plane {
   glm::dvec3 n;
   double d;  // inside where dot(n, p) + d >= 0
 };
-
-// Marks a traversal stack entry that emits a node's polygons instead of visiting it.
-constexpr std::int32_t kEmitBit = std::int32_t{1} << 30;
 
 // The view volume's side and near planes, pointing inwards.
 std::array<Plane, 5> frustum_planes(const Camera& c) {
@@ -302,6 +291,21 @@ double box_area_px(const Camera& c, const glm::dvec3& f, const glm::dvec3& r, co
   return (x1 - x0) * (y1 - y0);
 }
 
+// Traversal stack items: an implicit node name or a slot to emit, packed into 64 bits.
+// Bits 0-2 kind, 3-8 level + top, 9-29 ci, 30-50 cj, 51 half (which x half); slots: bits 3+.
+enum : std::uint64_t { kSquare = 0, kHalf = 1, kEmitSlot = 2, kLeaf = 3 };
+constexpr std::uint64_t pack(std::uint64_t kind, int level_index, int ci, int cj, int half = 0) {
+  return kind | (static_cast<std::uint64_t>(level_index) << 3) | (static_cast<std::uint64_t>(ci) << 9) |
+         (static_cast<std::uint64_t>(cj) << 30) | (static_cast<std::uint64_t>(half) << 51);
+}
+constexpr std::uint64_t pack_slot(std::int32_t slot) { return kEmitSlot | (static_cast<std::uint64_t>(slot) << 3); }
+constexpr std::uint64_t kind_of(std::uint64_t item) { return item & 7u; }
+constexpr int level_index_of(std::uint64_t item) { return static_cast<int>((item >> 3) & 63u); }
+constexpr int ci_of(std::uint64_t item) { return static_cast<int>((item >> 9) & 0x1FFFFFu); }
+constexpr int cj_of(std::uint64_t item) { return static_cast<int>((item >> 30) & 0x1FFFFFu); }
+constexpr int half_of(std::uint64_t item) { return static_cast<int>((item >> 51) & 1u); }
+constexpr std::int32_t slot_of(std::uint64_t item) { return static_cast<std::int32_t>(item >> 3); }
+
 }  // namespace
 
 void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const {
@@ -330,52 +334,118 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   const glm::dvec3 e = camera.eye;
   const bool back_to_front = !options.front_to_back;
 
-  // Pass 1: walk the tree, choose LODs, collect the drawn cells in order.
+  // The highest merged content in a cell's subtree (-inf when none).
+  const auto content_top = [&](int level, int ci, int cj) {
+    if (level < 0) return m.top_content.empty() ? -std::numeric_limits<float>::infinity()
+                                                : m.top_content[static_cast<std::size_t>(level + m.top)][static_cast<std::size_t>(cj * m.cells_at(level) + ci)];
+    if (m.content_index.empty()) return -std::numeric_limits<float>::infinity();
+    const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+    return c < 0 ? -std::numeric_limits<float>::infinity() : m.content[static_cast<std::size_t>(c)].top;
+  };
+
+  // Pass 1: walk the tree, choose LODs, collect the drawn cells and slots in order. Items on
+  // the stack are pushed in reverse of the order they are to come out in.
   auto& stack = frame.stack_;
   auto& leaves = frame.leaves_;
   stack.clear();
   leaves.clear();
-  stack.push_back(0);
+  const auto push_pair = [&](std::uint64_t far_item, std::uint64_t near_item) {
+    stack.push_back(back_to_front ? near_item : far_item);
+    stack.push_back(back_to_front ? far_item : near_item);
+  };
+  // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
+  // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]).
+  {
+    std::uint64_t order[5];
+    int count = 0;
+    const bool eye_beyond[4] = {e.x < m.xs.front(), e.x > m.xs.back(), e.y < m.ys.front(), e.y > m.ys.back()};
+    // Built from the innermost out: the window, then each boundary plane's outside slot on
+    // the far or near side of what is inside it.
+    order[count++] = pack(kSquare, 0, 0, 0);
+    for (int side = 3; side >= 0; --side) {
+      if (m.outside[side] < 0) continue;
+      const std::uint64_t slot = pack_slot(m.outside[side]);
+      const bool slot_near = eye_beyond[side];
+      if (slot_near == back_to_front) {
+        order[count++] = slot;  // drawn after everything inside
+      } else {
+        std::move_backward(order, order + count, order + count + 1);
+        order[0] = slot;
+        ++count;
+      }
+    }
+    for (int k = count; k-- > 0;) stack.push_back(order[k]);
+  }
   while (!stack.empty()) {
-    const std::int32_t top = stack.back();
+    const std::uint64_t item = stack.back();
     stack.pop_back();
-    if (top & kEmitBit) {  // a split node's coplanar polygons, between its far and near sides
-      leaves.push_back(top);
+    const std::uint64_t kind = kind_of(item);
+    if (kind == kEmitSlot || kind == kLeaf) {
+      leaves.push_back(item);
       continue;
     }
-    const Node& node = m.nodes[static_cast<std::size_t>(top)];
+    const int level_index = level_index_of(item), level = level_index - m.top;
+    const int ci = ci_of(item), cj = cj_of(item);
+    const int s = m.cell_size(level), half = s / 2;
+    const int i0 = ci * s, j0 = cj * s;
     ++frame.nodes_visited;
-    if (options.cull && box_outside(planes, node.lo, node.hi)) continue;
-    if (node.kind == kCell) {
-      bool refine = node.child[0] >= 0;
+    if (kind == kHalf) {  // the y split of one x half of a square; its box is its two children's
+      const int a = half_of(item);
+      const int hi0 = i0 + a * half;
+      const CellZ z0 = m.cell_z(level + 1, 2 * ci + a, 2 * cj), z1 = m.cell_z(level + 1, 2 * ci + a, 2 * cj + 1);
+      const float top = std::max({z0.zmax, z1.zmax, content_top(level + 1, 2 * ci + a, 2 * cj),
+                                  content_top(level + 1, 2 * ci + a, 2 * cj + 1)});
+      if (options.cull && box_outside(planes,
+                                      glm::vec3(static_cast<float>(m.xs[hi0]), static_cast<float>(m.ys[j0]), std::min(z0.zmin, z1.zmin)),
+                                      glm::vec3(static_cast<float>(m.xs[hi0 + half]), static_cast<float>(m.ys[j0 + s]), top)))
+        continue;
+      const bool eye_north = e.y >= m.ys[j0 + half];
+      const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
+      const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
+      if (eye_north) push_pair(south, north); else push_pair(north, south);
+      continue;
+    }
+    // A square: a top cell (always split) or an LOD cell.
+    const CellZ cz = m.cell_z(level, ci, cj);
+    const glm::vec3 lo(static_cast<float>(m.xs[i0]), static_cast<float>(m.ys[j0]), cz.zmin);
+    const glm::vec3 hi(static_cast<float>(m.xs[i0 + s]), static_cast<float>(m.ys[j0 + s]), cz.zmax);
+    const float top = std::max(hi.z, content_top(level, ci, cj));
+    if (options.cull && box_outside(planes, lo, glm::vec3(hi.x, hi.y, top))) continue;
+    bool refine = level < m.levels - 1;
+    const CellContent* content = nullptr;
+    if (level >= 0) {
       if (refine && !options.full_res) {
         if (options.metric == LodMetric::kError) {
-          const double dist = std::max(box_distance(e, node.lo, node.hi), camera.near_plane);
-          refine = node.error * focal_px / dist > options.threshold_px;
+          const double dist = std::max(box_distance(e, lo, hi), camera.near_plane);
+          refine = cz.error * focal_px / dist > options.threshold_px;
         } else {
-          refine = box_area_px(camera, f, r, u, focal_px, node.lo, node.hi) > options.threshold_px;
+          refine = box_area_px(camera, f, r, u, focal_px, lo, hi) > options.threshold_px;
         }
       }
-      if (refine) {
-        stack.push_back(node.child[0]);
-      } else {
-        leaves.push_back(static_cast<std::int32_t>(&node - m.nodes.data()));
-        frame.stamp_[node.cell] = stamp;
-        ++frame.lod_histogram[node.level];
+      if (!m.content_index.empty()) {
+        const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+        if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
       }
-      continue;
     }
-    // The eye's side of the plane: its own side is near. Push the near child first so that
-    // the far child is popped (drawn) first; the reverse for front-to-back.
-    const double eye_coord = node.kind == kSplitX ? e.x : e.y;
-    const bool eye_high = eye_coord >= node.plane;
-    const std::int32_t near_child = node.child[eye_high ? 1 : 0], far_child = node.child[eye_high ? 0 : 1];
-    const std::int32_t first = back_to_front ? far_child : near_child, second = back_to_front ? near_child : far_child;
-    stack.push_back(second);
-    if (node.extra >= 0) stack.push_back(kEmitBit | static_cast<std::int32_t>(&node - m.nodes.data()));  // its coplanar polygons
-    stack.push_back(first);
+    // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
+    // eye is below the plane z = zmax they are far), the terrain part, the pieces above (when
+    // the eye is above that plane they are near). Pushed in reverse.
+    const bool above_near = e.z >= static_cast<double>(cz.zmax);
+    const bool above_first = content && content->above >= 0 && above_near != back_to_front;
+    const bool above_last = content && content->above >= 0 && !above_first;
+    if (above_last) stack.push_back(pack_slot(content->above));
+    if (refine) {
+      const bool eye_east = e.x >= m.xs[i0 + half];
+      const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
+      if (eye_east) push_pair(west, east); else push_pair(east, west);
+    } else {
+      stack.push_back(pack(kLeaf, level_index, ci, cj));
+      frame.stamp_[m.cell_id(level, ci, cj)] = stamp;
+      ++frame.lod_histogram[static_cast<std::size_t>(level)];
+      ++frame.leaves;
+    }
+    if (above_first) stack.push_back(pack_slot(content->above));
   }
-  frame.leaves = static_cast<std::size_t>(std::count_if(leaves.begin(), leaves.end(), [](std::int32_t v) { return !(v & kEmitBit); }));
 
   // Which skirts can show a crack. With the eye above the ground, a ray reaching a gap under
   // the near cell's edge has crossed that cell's surface first, so only the skirts of cells
@@ -389,18 +459,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       return static_cast<int>(std::clamp<std::ptrdiff_t>(it - v.begin() - 1, 0, static_cast<std::ptrdiff_t>(v.size()) - 2));
     };
     const int i = clamp_index(m.xs, e.x), j = clamp_index(m.ys, e.y);
-    const float ground = std::max({m.positions[m.vertex(i, j)].z, m.positions[m.vertex(i + 1, j)].z,
-                                   m.positions[m.vertex(i, j + 1)].z, m.positions[m.vertex(i + 1, j + 1)].z});
-    const float low = std::min({m.positions[m.vertex(i, j)].z, m.positions[m.vertex(i + 1, j)].z,
-                                m.positions[m.vertex(i, j + 1)].z, m.positions[m.vertex(i + 1, j + 1)].z});
+    const float ground = std::max({m.z(i, j), m.z(i + 1, j), m.z(i, j + 1), m.z(i + 1, j + 1)});
+    const float low = std::min({m.z(i, j), m.z(i + 1, j), m.z(i, j + 1), m.z(i + 1, j + 1)});
     const int s0 = m.cell_size(0);
-    const float margin = m.level0_error[static_cast<std::size_t>((j / s0) * m.level_cells[0] + i / s0)];
+    const float margin = m.level0_error[static_cast<std::size_t>((j / s0) * m.cells_at(0) + i / s0)];
     if (e.z > ground + margin) draw_away = false;
     if (e.z < low - margin) draw_facing = false;
   }
 
-  // Pass 2: expand each drawn cell into its skirts and triangles, in order.
-  const auto count = static_cast<std::uint32_t>((m.n + 1) * (m.n + 1));
+  // Pass 2: expand each drawn cell into its skirts and triangles, and each slot into its
+  // polygons, in order.
+  const auto count = m.lattice_count();
   // Triangles are written through a cursor into buffers opened to their full capacity (grown
   // by doubling when a view needs more) and cut to size at the end: no per-triangle
   // bookkeeping of std::vector, and no allocation once the Frame is warm.
@@ -424,45 +493,42 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     emit(a, bottom + b, b, kSkirtLevel);
     frame.skirt_triangles += 2;
   };
-  auto emit_polygon = [&](const Polygon& p) {  // a convex planar polygon as a fan
-    for (std::uint32_t k = 1; k + 1 < p.count; ++k) {
-      emit(m.poly_vertices[p.first], m.poly_vertices[p.first + k], m.poly_vertices[p.first + k + 1], p.level);
-    }
-  };
-  // A leaf's small BSP: the far side of each plane first.
-  auto emit_leaf_bsp = [&](std::int32_t root) {
+  // A slot's small BSP: the far side of each plane first.
+  auto emit_store = [&](const BspStore& store) {
+    const auto ref = [&](std::uint32_t v) { return (v & kTerrainRef) ? (v & ~kTerrainRef) : store.base + v; };
     auto& st = frame.leaf_stack_;
     st.clear();
-    st.push_back(root);
+    if (store.root >= 0) st.push_back(store.root);
+    constexpr std::int32_t kEmitBit = std::int32_t{1} << 30;
     while (!st.empty()) {
       const std::int32_t top = st.back();
       st.pop_back();
       if (top & kEmitBit) {
-        const LeafNode& ln = m.leaf_nodes[static_cast<std::size_t>(top & ~kEmitBit)];
-        for (std::uint32_t k = 0; k < ln.count; ++k) emit_polygon(m.polygons[m.leaf_polys[ln.first + k]]);
+        const BspNode& bn = store.nodes[static_cast<std::size_t>(top & ~kEmitBit)];
+        for (std::uint32_t k = 0; k < bn.count; ++k) {
+          const Polygon& p = store.polys[bn.first + k];
+          const std::uint32_t a = ref(store.refs[p.first]);
+          for (std::uint32_t q = 1; q + 1 < p.count; ++q) emit(a, ref(store.refs[p.first + q]), ref(store.refs[p.first + q + 1]), p.level);
+        }
         continue;
       }
-      const LeafNode& ln = m.leaf_nodes[static_cast<std::size_t>(top)];
-      const bool eye_front = glm::dot(ln.n, e) + ln.d >= 0.0;
-      const std::int32_t far_side = eye_front ? ln.back : ln.front, near_side = eye_front ? ln.front : ln.back;
+      const BspNode& bn = store.nodes[static_cast<std::size_t>(top)];
+      const bool eye_front = glm::dot(bn.n, e) + bn.d >= 0.0;
+      const std::int32_t far_side = eye_front ? bn.back : bn.front, near_side = eye_front ? bn.front : bn.back;
       const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
       if (second >= 0) st.push_back(second);
       st.push_back(kEmitBit | top);
       if (first >= 0) st.push_back(first);
     }
   };
-  for (const std::int32_t item : leaves) {
-    if (item & kEmitBit) {
-      const Extra& x = m.extras[static_cast<std::size_t>(m.nodes[static_cast<std::size_t>(item & ~kEmitBit)].extra)];
-      for (std::uint32_t k = 0; k < x.count; ++k) emit_polygon(m.polygons[m.node_polys[x.first + k]]);
+  for (const std::uint64_t item : leaves) {
+    if (kind_of(item) == kEmitSlot) {
+      emit_store(m.slots[static_cast<std::size_t>(slot_of(item))].store);
       continue;
     }
-    const Node& node = m.nodes[static_cast<std::size_t>(item)];
-    const std::uint32_t cell = node.cell;
-    const int level = node.level;
-    const int s = m.cell_size(level), cells = m.level_cells[level];
-    const std::uint32_t local = cell - m.level_offset[level];
-    const int ci = static_cast<int>(local % cells), cj = static_cast<int>(local / cells);
+    const int level = level_index_of(item) - m.top;
+    const int ci = ci_of(item), cj = cj_of(item);
+    const int s = m.cell_size(level), cells = m.cells_at(level);
     const int i0 = ci * s, j0 = cj * s, i1 = i0 + s, j1 = j0 + s;
     const std::uint32_t sw = m.vertex(i0, j0), se = m.vertex(i1, j0), ne = m.vertex(i1, j1), nw = m.vertex(i0, j1);
 
@@ -483,23 +549,25 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       if (edge.needed && edge.faces_away == first_pass_far && (edge.faces_away ? draw_away : draw_facing))
         emit_skirt(edge.a, edge.b, edge.bottom);
 
-    if (node.extra >= 0 && m.extras[static_cast<std::size_t>(node.extra)].leaf_root >= 0) {
-      emit_leaf_bsp(m.extras[static_cast<std::size_t>(node.extra)].leaf_root);
-      for (const Edge& edge : edges)
-        if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))
-          emit_skirt(edge.a, edge.b, edge.bottom);
-      continue;
+    const CellContent* content = nullptr;
+    if (!m.content_index.empty()) {
+      const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+      if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
     }
-    // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
-    const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
-    const bool eye_south_east = side < 0;
-    const auto lvl = static_cast<std::int8_t>(level);
-    if (eye_south_east == back_to_front) {  // draw the north-west triangle first
-      emit(sw, ne, nw, lvl);
-      emit(sw, se, ne, lvl);
+    if (content && content->low >= 0) {
+      emit_store(m.slots[static_cast<std::size_t>(content->low)].store);
     } else {
-      emit(sw, se, ne, lvl);
-      emit(sw, ne, nw, lvl);
+      // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
+      const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
+      const bool eye_south_east = side < 0;
+      const auto lvl = static_cast<std::int8_t>(level);
+      if (eye_south_east == back_to_front) {  // draw the north-west triangle first
+        emit(sw, ne, nw, lvl);
+        emit(sw, se, ne, lvl);
+      } else {
+        emit(sw, se, ne, lvl);
+        emit(sw, ne, nw, lvl);
+      }
     }
     for (const Edge& edge : edges)
       if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))

@@ -60,12 +60,26 @@ struct TraversalOptions {
 inline constexpr std::int8_t kSkirtLevel = -1;   // a crack skirt
 inline constexpr std::int8_t kMergedLevel = -2;  // a merged polygon (isosurface, slice, ...)
 
-// What merging did (section 4.2).
+// What merging did (section 4.2), for the whole tree after the last change.
 struct MergeStats {
+  std::size_t surfaces = 0;
   std::size_t input_triangles = 0;
-  std::size_t stored_polygons = 0;  // after splitting by planes and copying into every LOD alternative
-  std::size_t merged_vertices = 0;  // input vertices plus those made by splitting
-  double merge_ms = 0.0;
+  std::size_t stored_polygons = 0;  // merged pieces kept in the tree, all LOD copies counted
+  std::size_t dropped_pieces = 0;   // pieces found below the terrain (never visible) and dropped
+  std::size_t slots = 0;            // small BSPs
+  std::size_t merged_vertices = 0;  // vertices of the stored pieces (positions() after merged_base())
+  std::size_t rebuilt_slots = 0;    // of the last change: small BSPs made again
+  double distribute_ms = 0.0;       // of the last change: sending its surfaces through the tree
+  double build_ms = 0.0;            // of the last change: the small BSPs and the vertices
+  double merge_ms = 0.0;            // of the last change: all of it
+};
+
+// A surface to merge: three indices per triangle into `vertices` (scene frame, metres), with
+// per-vertex RGBA `colors` (translucent or opaque).
+struct SurfaceInput {
+  std::span<const glm::dvec3> vertices;
+  std::span<const glm::u8vec4> colors;
+  std::span<const std::uint32_t> triangles;
 };
 
 // Bytes a TerrainTree holds, by part: the capacities of its containers times their element
@@ -91,8 +105,8 @@ struct Frame {
   std::vector<std::size_t> lod_histogram;  // leaves drawn per level
 
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
-  std::vector<std::int32_t> stack_;
-  std::vector<std::int32_t> leaves_;
+  std::vector<std::uint64_t> stack_;
+  std::vector<std::uint64_t> leaves_;
   std::vector<std::int32_t> leaf_stack_;
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
@@ -127,6 +141,9 @@ class TerrainTree {
   // plane first; skirts on boundary planes facing away from the eye before the cell,
   // facing it after). Cracks between neighbours at different levels are filled with skirts:
   // vertical quads in the shared boundary plane hanging to the skirt-bottom vertices.
+  // Culling (options.cull) tests each region's box holding everything drawn in it: its
+  // terrain and the merged pieces kept in its subtree. The LOD choice uses the terrain's own
+  // box and error, so merging never changes which terrain is drawn.
   void traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const;
 
   // Sliding (section 4.3): replace the heights and plane offsets for a window moved over the
@@ -135,18 +152,30 @@ class TerrainTree {
   // constructor, and window.cells must equal cells().
   void slide(const TerrainWindow& window);
 
-  // Merges other polygons into the tree (section 4.2), replacing those merged before: each
-  // triangle (three indices into `vertices`, scene frame, with per-vertex RGBA `colors`,
-  // translucent or opaque) is inserted from the root as in an ordinary BSP: classified
-  // against each split plane in double precision with a tolerance of 1e-9 times the window
-  // size, split where it spans, kept at the node where it lies in the plane (drawn between
-  // the far and the near side), copied clipped into every alternative of an LOD list, and
-  // ordered against the cell's terrain triangles by a small BSP in each leaf (autopartition,
-  // the cell's diagonal plane first). Merged vertices follow the terrain's in positions();
-  // their colours are merged_colors(). slide() merges them again into the moved window.
-  // Throws std::invalid_argument for an index out of range or sizes that disagree.
+  // Merging other polygons (section 4.2). Each surface (an isosurface, a slice, ...) is kept
+  // under its id; set_surface() replaces what that id held (an empty surface removes it) and
+  // re-merges only the small BSPs its old and new pieces touch, so an edit costs about what
+  // that surface costs. Each triangle is sent from the root through the window's boundary
+  // planes (what lies outside the window is kept in four BSPs beyond them) and the cells'
+  // split planes, classified in double precision with a tolerance of 1e-9 times the window
+  // size; at a cell of an LOD level, a piece entirely above the cell's terrain (above zmax)
+  // stays there whole, in a small BSP ordered against all of the cell's terrain by the plane
+  // z = zmax; a piece entirely below the cell's terrain (below zmin) is dropped, since no eye
+  // above the ground can see it; what lies between is copied into the cell's low alternative
+  // (ordered against its two triangles by the cell's diagonal plane and their planes, parts
+  // below the triangles dropped) and sent on into its children. Pieces that straddle zmax are
+  // cut there. Small BSPs are autopartitions whose splitters are chosen among sampled
+  // candidates by fewest spans. A split makes one vertex per edge and plane. Merged vertices
+  // follow the terrain's in positions(); their colours are merged_colors(). slide() merges
+  // every surface again into the moved window. Throws std::invalid_argument for an index out
+  // of range or sizes that disagree (and then changes nothing).
+  MergeStats set_surface(std::uint32_t id, const SurfaceInput& surface);
+  // Several at once (one re-merge): surfaces[k] replaces id ids[k].
+  MergeStats set_surfaces(std::span<const std::uint32_t> ids, std::span<const SurfaceInput> surfaces);
+  // Replaces every surface by one (id 0).
   MergeStats merge(std::span<const glm::dvec3> vertices, std::span<const glm::u8vec4> colors,
                    std::span<const std::uint32_t> triangles);
+  const MergeStats& merge_stats() const;
   // RGBA of merged vertex k, which is positions()[merged_base() + k].
   const std::vector<glm::u8vec4>& merged_colors() const;
   std::uint32_t merged_base() const;

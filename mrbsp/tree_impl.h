@@ -1,5 +1,15 @@
-// Private to mrbsp/: the flat storage of TerrainTree, shared by terrain_tree.cpp (build,
-// refresh, traversal) and merge.cpp (merging other polygons, section 4.2).
+// Private to mrbsp/: the storage of TerrainTree, shared by terrain_tree.cpp (refresh,
+// traversal) and merge.cpp (merging other polygons, section 4.2).
+//
+// The topology is implicit (nothing of it is stored): a square region is a *cell* (level,
+// ci, cj) of side cell_size(level) samples. Levels 0 .. L-1 are the LOD levels (0 coarsest,
+// L-1 the full resolution); levels -1 .. -m are coarser *top* levels above level 0 that only
+// organise the window (level -m is one cell, the whole window) and carry no LOD choice. Every
+// cell above the finest splits first at its middle x line into two halves, then each half at
+// its middle y line, into its four children (level + 1, 2 ci + a, 2 cj + b): the split
+// planes x = xs[i] and y = ys[j] lie on lattice lines of the coarser level, as section 4.1
+// asks. At a cell of level >= 0 the LOD choice is between its low alternative (its two
+// triangles) and its children (the high alternative).
 #pragma once
 
 #include <cstdint>
@@ -12,84 +22,134 @@
 
 namespace terravol::mrbsp {
 
-enum : std::uint8_t { kSplitX = 0, kSplitY = 1, kCell = 2 };
-
-// One node of the flat tree (pre-order: children always follow their parent).
-struct Node {
-  glm::vec3 lo{0.0f}, hi{0.0f};      // bounding box of the region's samples (scene frame)
-  float error = 0.0f;                // cell: largest |low-alternative height - full-res sample| (m)
-  float plane = 0.0f;                // split: offset of the plane x = plane or y = plane
-  std::int32_t child[2] = {-1, -1};  // split: [0] west/south side, [1] east/north side;
-                                     // cell: child[0] = high alternative, or -1 at the finest level
-  std::uint32_t cell = 0;            // cell: global cell id (Impl::cell_id)
-  std::int32_t line = 0;             // split: lattice line index of the plane
-  std::int32_t extra = -1;           // index into Impl::extras when merged polygons touch the node
-  std::uint8_t kind = kSplitX;
-  std::uint8_t level = 0;
+// Terrain figures of one cell: the range of its full-resolution samples (every alternative
+// and every skirt top of the region lies within it) and the largest vertical error of its low
+// alternative against them (0 at the finest level, unused at top levels).
+struct CellZ {
+  float zmin = 0.0f, zmax = 0.0f, error = 0.0f;
 };
 
-// A convex planar polygon: `count` vertex indices (into positions()) from poly_vertices[first].
+// A convex planar polygon of a small BSP: `count` vertex references from BspStore::refs[first].
+// A reference with kTerrainRef set is a lattice vertex (the rest of the bits), otherwise an
+// index into the store's vertices (its slot's base is added when drawn).
 struct Polygon {
   std::uint32_t first = 0;
-  std::uint32_t count = 0;
+  std::uint16_t count = 0;
   std::int8_t level = kMergedLevel;  // the terrain level for a cell's own triangles
 };
+inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 
-// A node of a leaf's small BSP (section 4.2, "in a terrain leaf"): the plane n.p + d = 0,
-// the polygons lying in it, and the two sides. Children are -1 when empty.
-struct LeafNode {
+// A node of a small BSP (section 4.2, "in a terrain leaf" and above the terrain): the plane
+// n.p + d = 0, the polygons lying in it, and the two sides (-1 when empty).
+struct BspNode {
   glm::dvec3 n{0.0};
   double d = 0.0;
   std::int32_t back = -1, front = -1;
-  std::uint32_t first = 0, count = 0;  // into Impl::leaf_polys
+  std::uint32_t first = 0, count = 0;  // into the store's polys
 };
 
-// Merged content of one tree node: coplanar polygons of a split node, or the leaf BSP of a
-// cell's low alternative.
-struct Extra {
-  std::uint32_t first = 0, count = 0;  // split node: polygon ids in Impl::node_polys
-  std::int32_t leaf_root = -1;         // cell node: root of its leaf BSP in Impl::leaf_nodes
+// The small BSPs of one slot, self-contained: nodes, polygons, references and its own copies
+// of the vertices it uses (float, as drawn, with their RGBA).
+struct BspStore {
+  std::vector<BspNode> nodes;
+  std::vector<Polygon> polys;
+  std::vector<std::uint32_t> refs;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::u8vec4> colors;
+  std::int32_t root = -1;
+  std::uint32_t base = 0;       // where its vertices start in TerrainTree::positions()
+  std::size_t pieces = 0;       // merged polygons (terrain triangles not counted)
+  std::size_t dropped = 0;      // pieces found below the low triangles and dropped
+  float top = 0.0f;             // highest merged vertex
+  std::size_t bytes() const;
+};
+
+// Where merged polygons are kept. Per cell of level >= 0: kAbove holds the pieces of the
+// cell's region above its ceiling zmax (ordered against the whole terrain of the region by the
+// plane z = zmax: the eye's side of it is near), kLow the cell's low alternative: its two
+// terrain triangles and the pieces above them. Around the window, kOutside slots hold what
+// lies beyond its four boundary planes (west, east, south, north, in this order: a piece
+// beyond two belongs to the first).
+enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
+
+// A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
+// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north).
+using SlotKey = std::uint64_t;
+inline constexpr SlotKey kOutsideKey0 = std::uint64_t{1} << 62;
+
+// What a cell's subtree holds of merged content, for cells that hold any (sparse).
+struct CellContent {
+  std::int32_t above = -1, low = -1;  // slot indices (into Impl::slots), -1 when none
+  float top = 0.0f;                   // highest merged vertex in the subtree
+};
+
+// One surface's polygons after distribution through the tree's planes (merge.cpp): pieces
+// arrived at slots, in the order they were made. Vertices are the input's followed by those
+// made by splitting (double precision, for classification).
+struct SurfacePieces {
+  std::size_t input_triangles = 0;
+  std::size_t input_vertices = 0;           // the first vertices are the input's
+  std::vector<std::uint32_t> triangles;      // the input triangles (kept for slide())
+  std::vector<glm::dvec3> vertices;
+  std::vector<glm::u8vec4> colors;
+  struct Piece {
+    SlotKey slot;
+    std::uint32_t first;  // into refs
+    std::uint32_t count;
+  };
+  std::vector<Piece> pieces;  // sorted by slot, stable
+  std::vector<std::uint32_t> refs;
+  std::size_t dropped = 0;  // pieces found below the terrain and dropped
+  std::size_t bytes() const;
+};
+
+struct Slot {
+  SlotKey key = 0;
+  BspStore store;
 };
 
 struct TerrainTree::Impl {
   int n = 0;       // cells per side
   int levels = 0;  // L
-  std::vector<Node> nodes;
+  int top = 0;     // m: top levels -1 .. -m
   std::vector<double> xs, ys;
   std::vector<glm::vec3> positions;  // lattice, row bottoms, column bottoms, merged vertices
-  std::vector<std::uint32_t> level_offset;  // first global cell id of each level
-  std::vector<int> level_cells;             // cells per side at each level
-  std::uint32_t total_cells = 0;
-  std::vector<float> level0_error;  // per level-0 cell: the largest error of any cell inside it
+  // Per level index l + top (l = -m .. L-2): its cells' figures, row-major from the south-west.
+  std::vector<std::vector<CellZ>> cellz;
+  std::vector<std::uint32_t> level_offset;  // first global cell id of each LOD level (>= 0)
+  std::uint32_t total_cells = 0;            // cells of all LOD levels
+  std::vector<float> level0_error;          // per level-0 cell: the largest error of any cell inside it
 
-  // Merged polygons (merge.cpp). The inputs are kept so that slide() can merge them again.
-  // Every merge leaves each container at the size it needs (no growth slack), so memory
-  // follows the current merge, not the largest so far.
-  // The merged vertices are kept once, as floats in `positions`: their double copies, which
-  // classification needs, live only while a merge runs.
-  std::vector<glm::dvec3> merge_input_positions;
-  std::vector<glm::u8vec4> merge_input_colors;
-  std::vector<std::uint32_t> merge_input_triangles;
+  // Merged content. Surfaces by id; slots sorted by key; cell content by global cell id (top
+  // levels by level and index in top_content).
+  std::vector<std::pair<std::uint32_t, SurfacePieces>> surfaces;  // sorted by id
+  std::vector<Slot> slots;                                           // sorted by key
+  std::vector<std::int32_t> content_index;                           // per global cell id: into content, or -1
+  std::vector<CellContent> content;
+  std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
+  std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
   std::vector<glm::u8vec4> merged_colors;
-  std::vector<Polygon> polygons;
-  std::vector<std::uint32_t> poly_vertices;
-  std::vector<std::uint32_t> node_polys;
-  std::vector<Extra> extras;
-  std::vector<LeafNode> leaf_nodes;
-  std::vector<std::uint32_t> leaf_polys;
   MergeStats merge_stats;
 
+  int cells_at(int level) const { return n >> (levels - 1 - level); }  // per side, any level >= -top
   int cell_size(int level) const { return 1 << (levels - 1 - level); }
   std::uint32_t cell_id(int level, int ci, int cj) const {
-    return level_offset[level] + static_cast<std::uint32_t>(cj * level_cells[level] + ci);
+    return level_offset[static_cast<std::size_t>(level)] + static_cast<std::uint32_t>(cj * cells_at(level) + ci);
   }
   std::uint32_t vertex(int i, int j) const { return static_cast<std::uint32_t>(j * (n + 1) + i); }
   std::uint32_t lattice_count() const { return static_cast<std::uint32_t>((n + 1) * (n + 1)); }
   std::uint32_t merged_base() const { return 3 * lattice_count(); }
+  float z(int i, int j) const { return positions[vertex(i, j)].z; }
+  // The figures of a cell at any level >= -top; the finest level's from its four samples.
+  CellZ cell_z(int level, int ci, int cj) const;
 
-  std::int32_t build_region(int rx, int ry, int w, int h, int level);
   void refresh(const TerrainWindow& window);
-  void merge();  // (re)merges merge_input_* into the current tree
+  // Merging (merge.cpp). distribute() sends one surface's triangles through the tree;
+  // rebuild() makes the slots whose keys are in `dirty` again from every surface's pieces,
+  // then the cell content and the merged vertices.
+  void distribute(SurfacePieces& s) const;
+  void rebuild(const std::vector<SlotKey>& dirty);
+  void redistribute_all();  // after refresh(): every surface again, every slot
 };
 
 }  // namespace terravol::mrbsp

@@ -10,15 +10,13 @@
 namespace terravol::mrbsp {
 namespace {
 
+using test::drawn_merged_area;
 using test::order_violations;
 using test::TestWindow;
 
 // Random triangles through the terrain's volume (big and small), plus two lying exactly in
 // split planes (the root's x = 800 and a y plane), all translucent.
-struct Soup {
-  std::vector<glm::dvec3> v;
-  std::vector<glm::u8vec4> c;
-  std::vector<std::uint32_t> t;
+struct Soup : test::TriangleSoup {
   double area = 0.0;
   void add(glm::dvec3 a, glm::dvec3 b, glm::dvec3 d) {
     const auto base = static_cast<std::uint32_t>(v.size());
@@ -29,7 +27,9 @@ struct Soup {
   }
 };
 
-Soup random_soup(std::mt19937& rng, int count) {
+// With `in_planes`, two more lie exactly in split planes; the area tests leave them out, since
+// the brute-force reference counts a polygon on a boundary in both regions it bounds.
+Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
   std::uniform_real_distribution<double> xy(-100.0, 1700.0), z(-50.0, 500.0), small(-150.0, 150.0);
   Soup s;
   for (int k = 0; k < count; ++k) {
@@ -40,20 +40,11 @@ Soup random_soup(std::mt19937& rng, int count) {
       s.add(a, {xy(rng), xy(rng), z(rng)}, {xy(rng), xy(rng), z(rng)});
     }
   }
-  s.add({800.0, 100.0, 0.0}, {800.0, 900.0, 50.0}, {800.0, 500.0, 450.0});  // in the root plane
-  s.add({300.0, 400.0, 20.0}, {1200.0, 400.0, 30.0}, {700.0, 400.0, 380.0});  // in a y plane
-  return s;
-}
-
-double drawn_merged_area(const TerrainTree& tree, const Frame& f) {
-  double area = 0.0;
-  const auto& p = tree.positions();
-  for (std::size_t t = 0; t < f.level.size(); ++t) {
-    if (f.level[t] != kMergedLevel) continue;
-    const glm::dvec3 a(p[f.indices[3 * t]]), b(p[f.indices[3 * t + 1]]), c(p[f.indices[3 * t + 2]]);
-    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+  if (in_planes) {
+    s.add({800.0, 100.0, 0.0}, {800.0, 900.0, 50.0}, {800.0, 500.0, 450.0});   // in the root plane
+    s.add({300.0, 400.0, 20.0}, {1200.0, 400.0, 30.0}, {700.0, 400.0, 380.0});  // in a y plane
   }
-  return area;
+  return s;
 }
 
 TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
@@ -63,24 +54,39 @@ TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
   return TerrainTree(w.view(), 4);
 }
 
+// A camera at `eye` looking along `forward` (not vertical), 60 degrees wide.
+Camera camera_at(const glm::dvec3& eye, glm::dvec3 forward) {
+  Camera c;
+  c.eye = eye;
+  c.forward = glm::normalize(forward);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  c.fov_y_deg = 60.0;
+  c.width = 320;
+  c.height = 200;
+  c.near_plane = 0.5;
+  return c;
+}
+
+// The window's footprint: 16 cells of 100 m from the origin.
+constexpr double kX0 = 0.0, kX1 = 1600.0;
+
 TEST(Merge, MergedAndTerrainTrianglesAreInBackToFrontOrderFromRandomEyes) {
   std::mt19937 rng(77);
   TestWindow w(16, [](int, int) { return 0.0f; });
   TerrainTree tree = hilly_tree(rng, w);
   const Soup soup = random_soup(rng, 24);
   const MergeStats stats = tree.merge(soup.v, soup.c, soup.t);
-  EXPECT_EQ(stats.input_triangles, soup.t.size() / 3);
+  EXPECT_EQ(stats.input_triangles, soup.size());
   EXPECT_GT(stats.stored_polygons, stats.input_triangles) << "spanning triangles are split and copied per LOD";
-  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(-200.0, 900.0);
+  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(-200.0, 900.0), dir(-1.0, 1.0);
   Frame f;
   std::size_t merged = 0;
   for (int trial = 0; trial < 40; ++trial) {
     glm::dvec3 eye(xy(rng), xy(rng), z(rng));
     if (trial % 3 == 0) eye.x = 800.0;
-    Camera c;
-    c.eye = eye;
+    Camera c = camera_at(eye, {dir(rng), dir(rng), 0.6 * dir(rng)});
     TraversalOptions o;
-    o.cull = false;
+    o.cull = trial % 2 == 0;  // culling by content boxes must keep the order of what it keeps
     o.threshold_px = 2.0f * static_cast<float>(1 << (trial % 7));
     o.front_to_back = trial % 5 == 4;
     tree.traverse(c, o, f);
@@ -90,14 +96,17 @@ TEST(Merge, MergedAndTerrainTrianglesAreInBackToFrontOrderFromRandomEyes) {
   EXPECT_GT(merged, 0u);
 }
 
-// Each part of each merged triangle is drawn exactly once, whatever the LOD choice: copies
-// live in every alternative, but one alternative is drawn per region.
-TEST(Merge, DrawnMergedAreaEqualsTheInputAreaAtEveryThreshold) {
+// Each visible part of each merged triangle is drawn exactly once, whatever the LOD choice:
+// copies live in every alternative, one alternative is drawn per region, and what is dropped
+// lies below the terrain drawn there. The reference clips the input triangles against the
+// frame's terrain triangles by brute force.
+TEST(Merge, DrawnMergedAreaIsTheInputAreaAboveTheDrawnTerrainAtEveryThreshold) {
   std::mt19937 rng(3);
   TestWindow w(16, [](int, int) { return 0.0f; });
   TerrainTree tree = hilly_tree(rng, w);
-  const Soup soup = random_soup(rng, 30);
+  const Soup soup = random_soup(rng, 30, false);
   tree.merge(soup.v, soup.c, soup.t);
+  EXPECT_GT(tree.merge_stats().dropped_pieces, 0u) << "the soup reaches below the terrain";
   Camera c;
   c.eye = {-400.0, -300.0, 700.0};
   Frame f;
@@ -106,20 +115,53 @@ TEST(Merge, DrawnMergedAreaEqualsTheInputAreaAtEveryThreshold) {
     o.cull = false;
     o.threshold_px = t;
     tree.traverse(c, o, f);
-    EXPECT_NEAR(drawn_merged_area(tree, f), soup.area, 1e-6 * soup.area) << "threshold " << t;
+    const double expected = test::area_above_drawn_terrain(tree, f, soup, kX0, kX1, kX0, kX1);
+    EXPECT_GT(expected, 0.2 * soup.area);
+    EXPECT_NEAR(drawn_merged_area(tree, f), expected, 1e-6 * soup.area) << "threshold " << t;
   }
   TraversalOptions full;
   full.cull = false;
   full.full_res = true;
   tree.traverse(c, full, f);
-  EXPECT_NEAR(drawn_merged_area(tree, f), soup.area, 1e-6 * soup.area);
+  EXPECT_NEAR(drawn_merged_area(tree, f), test::area_above_drawn_terrain(tree, f, soup, kX0, kX1, kX0, kX1),
+              1e-6 * soup.area);
+}
+
+// Culling by content boxes: from cameras inside and beside the merged triangles, low over the
+// ground and looking up, down and level, the merged area drawn inside the view frustum is the
+// input's visible area inside it (the reference clips the inputs to the frustum, derived by
+// the test from the camera, and to the terrain drawn at the same LOD without culling, since a
+// piece above culled terrain may still be in view).
+TEST(Merge, WithCullingTheDrawnAreaInsideTheFrustumIsTheVisibleInputInsideIt) {
+  std::mt19937 rng(41);
+  TestWindow w(16, [](int, int) { return 0.0f; });
+  TerrainTree tree = hilly_tree(rng, w);
+  const Soup soup = random_soup(rng, 40, false);
+  tree.merge(soup.v, soup.c, soup.t);
+  std::uniform_real_distribution<double> xy(-200.0, 1800.0), z(250.0, 700.0), dir(-1.0, 1.0), pitch(-0.8, 0.8);
+  Frame f, unculled;
+  double seen = 0.0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+    const Camera c = camera_at(eye, {dir(rng), dir(rng), pitch(rng)});
+    TraversalOptions o;
+    o.threshold_px = 1.0f + static_cast<float>(trial % 5);
+    tree.traverse(c, o, f);
+    o.cull = false;
+    tree.traverse(c, o, unculled);
+    const auto frustum = test::frustum_of(c);
+    const double expected = test::area_above_drawn_terrain(tree, unculled, soup, kX0, kX1, kX0, kX1, frustum);
+    EXPECT_NEAR(drawn_merged_area(tree, f, frustum), expected, 1e-6 * soup.area + 1e-3) << "trial " << trial;
+    seen += expected;
+  }
+  EXPECT_GT(seen, 0.0);
 }
 
 TEST(Merge, SlidingMergesThePolygonsAgainIntoTheMovedWindow) {
   std::mt19937 rng(12);
   TestWindow w(16, [](int, int) { return 0.0f; });
   TerrainTree tree = hilly_tree(rng, w);
-  const Soup soup = random_soup(rng, 10);
+  const Soup soup = random_soup(rng, 10, false);
   tree.merge(soup.v, soup.c, soup.t);
   TestWindow moved(16, [](int i, int j) { return static_cast<float>(i + j); }, 400.0, 0.0);
   tree.slide(moved.view());
@@ -131,7 +173,82 @@ TEST(Merge, SlidingMergesThePolygonsAgainIntoTheMovedWindow) {
   TraversalOptions o;
   o.cull = false;
   tree.traverse(c, o, f);
-  EXPECT_NEAR(drawn_merged_area(tree, f), soup.area, 1e-6 * soup.area);
+  EXPECT_NEAR(drawn_merged_area(tree, f), test::area_above_drawn_terrain(tree, f, soup, 400.0, 2000.0, 0.0, 1600.0),
+              1e-6 * soup.area);
+}
+
+// A surface entirely above a cell's terrain stays whole at that cell: a flat sheet of 8
+// triangles over one level-0 cell is stored as 8 pieces, and one below the terrain not at all.
+TEST(Merge, PiecesAboveTheTerrainStayWholeAndPiecesBelowItAreDropped) {
+  TestWindow w(16, [](int i, int j) { return static_cast<float>(10 * i + 5 * j); });
+  TerrainTree tree(w.view(), 3);  // level 0: 4 x 4 cells of 400 m
+  test::TriangleSoup sheet;
+  const auto grid = [&](double z) {
+    test::TriangleSoup s;
+    for (int j = 0; j <= 2; ++j)
+      for (int i = 0; i <= 2; ++i) {
+        s.v.emplace_back(410.0 + 190.0 * i, 410.0 + 190.0 * j, z);
+        s.c.emplace_back(10, 200, 10, 100);
+      }
+    for (std::uint32_t j = 0; j < 2; ++j)
+      for (std::uint32_t i = 0; i < 2; ++i) {
+        const std::uint32_t a = j * 3 + i;
+        s.t.insert(s.t.end(), {a, a + 1, a + 4, a, a + 4, a + 3});
+      }
+    return s;
+  };
+  sheet = grid(500.0);  // the terrain reaches 240 m
+  MergeStats stats = tree.merge(sheet.v, sheet.c, sheet.t);
+  EXPECT_EQ(stats.stored_polygons, 8u);
+  EXPECT_EQ(stats.slots, 1u);
+  EXPECT_EQ(stats.dropped_pieces, 0u);
+  const test::TriangleSoup under = grid(-100.0);
+  stats = tree.merge(under.v, under.c, under.t);
+  EXPECT_EQ(stats.stored_polygons, 0u);
+  EXPECT_EQ(stats.slots, 0u);
+  EXPECT_GT(stats.dropped_pieces, 0u);
+}
+
+// An edit re-merges only what it touches, and the tree it leaves is the one a merge of the
+// new set of surfaces from scratch gives: the same vertices and the same frames.
+TEST(Merge, ReplacingOneSurfaceGivesWhatMergingEverythingAnewGives) {
+  std::mt19937 rng(5);
+  TestWindow w(16, [](int, int) { return 0.0f; });
+  TerrainTree edited = hilly_tree(rng, w);
+  const Soup a = random_soup(rng, 12), b = random_soup(rng, 12), b2 = random_soup(rng, 8), c = random_soup(rng, 12);
+  const auto input = [](const Soup& s) { return SurfaceInput{s.v, s.c, s.t}; };
+  const std::uint32_t ids[3] = {4, 9, 2};
+  const SurfaceInput first[3] = {input(a), input(b), input(c)};
+  edited.set_surfaces(ids, first);
+  const std::size_t all_slots = edited.merge_stats().slots;
+  const MergeStats stats = edited.set_surface(9, input(b2));
+  EXPECT_LT(stats.rebuilt_slots, all_slots + stats.slots);
+  EXPECT_EQ(stats.surfaces, 3u);
+
+  TestWindow w2(16, [](int, int) { return 0.0f; });
+  std::mt19937 rng2(5);
+  TerrainTree fresh = hilly_tree(rng2, w2);
+  const SurfaceInput second[3] = {input(a), input(b2), input(c)};
+  fresh.set_surfaces(ids, second);
+  EXPECT_EQ(edited.positions(), fresh.positions());
+  EXPECT_EQ(edited.merged_colors(), fresh.merged_colors());
+  EXPECT_EQ(edited.merge_stats().stored_polygons, fresh.merge_stats().stored_polygons);
+  Frame fe, ff;
+  const Camera cam = camera_at({-200.0, -250.0, 600.0}, {1.0, 1.0, -0.4});
+  edited.traverse(cam, TraversalOptions{}, fe);
+  fresh.traverse(cam, TraversalOptions{}, ff);
+  EXPECT_EQ(fe.indices, ff.indices);
+
+  // Removing a surface leaves the others as they would be alone.
+  edited.set_surface(9, SurfaceInput{});
+  TestWindow w3(16, [](int, int) { return 0.0f; });
+  std::mt19937 rng3(5);
+  TerrainTree two = hilly_tree(rng3, w3);
+  const std::uint32_t two_ids[2] = {4, 2};
+  const SurfaceInput two_inputs[2] = {input(a), input(c)};
+  two.set_surfaces(two_ids, two_inputs);
+  EXPECT_EQ(edited.positions(), two.positions());
+  EXPECT_EQ(edited.merge_stats().surfaces, 2u);
 }
 
 TEST(Merge, RejectsIndicesOutOfRangeAndMismatchedColours) {

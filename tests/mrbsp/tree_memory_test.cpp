@@ -128,15 +128,15 @@ TEST(TerrainTreeMemory, GrowsAboutFourfoldWhenTheWindowSideDoubles) {
   EXPECT_EQ(b.memory().samples, 129u * 129u);
 }
 
-// The figure in the contract: about 170 bytes per lattice sample (2.3 nodes of 56 bytes and
-// three positions of 12 bytes per sample) for 3 or more levels.
-TEST(TerrainTreeMemory, HoldsAbout170BytesPerLatticeSample) {
+// The figure in the contract: about 40 bytes per lattice sample (three positions of 12 bytes,
+// and 12 bytes per cell above the finest level, of which there is about a third per sample).
+TEST(TerrainTreeMemory, HoldsAbout40BytesPerLatticeSample) {
   const TestWindow w(256, hills);
   const TerrainTree tree(w.view(), 6);
   const MemoryStats m = tree.memory();
   const double per_sample = static_cast<double>(m.total()) / static_cast<double>(m.samples);
-  EXPECT_GT(per_sample, 155.0);
-  EXPECT_LT(per_sample, 185.0);
+  EXPECT_GT(per_sample, 38.0);
+  EXPECT_LT(per_sample, 42.0);
 }
 
 }  // namespace

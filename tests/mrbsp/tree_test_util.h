@@ -88,3 +88,115 @@ inline int order_violations(const TerrainTree& tree, const Frame& f, const glm::
 }
 
 }  // namespace terravol::mrbsp::test
+
+namespace terravol::mrbsp::test {
+
+// --- An independent reference for merged areas: brute-force convex clipping -----------------
+
+using Poly3 = std::vector<glm::dvec3>;
+
+// The part of a convex polygon where dot(n, p) + d >= 0 (Sutherland-Hodgman, one plane).
+inline Poly3 clip_polygon(const Poly3& in, const glm::dvec3& n, double d) {
+  Poly3 out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const glm::dvec3 &a = in[i], &b = in[(i + 1) % in.size()];
+    const double sa = glm::dot(n, a) + d, sb = glm::dot(n, b) + d;
+    if (sa >= 0) out.push_back(a);
+    if ((sa >= 0) != (sb >= 0)) out.push_back(a + (b - a) * (sa / (sa - sb)));
+  }
+  return out;
+}
+
+inline double polygon_area(const Poly3& p) {
+  glm::dvec3 n(0.0);
+  for (std::size_t i = 1; i + 1 < p.size(); ++i) n += glm::cross(p[i] - p[0], p[i + 1] - p[0]);
+  return 0.5 * glm::length(n);
+}
+
+struct ClipPlane {
+  glm::dvec3 n;
+  double d;
+};
+
+inline Poly3 clip_all(Poly3 p, const std::vector<ClipPlane>& planes) {
+  for (const ClipPlane& c : planes) {
+    if (p.size() < 3) break;
+    p = clip_polygon(p, c.n, c.d);
+  }
+  return p;
+}
+
+// The view frustum of a camera (side planes and near plane, inside >= 0), derived here from
+// the camera's definition, independently of the traversal's own.
+inline std::vector<ClipPlane> frustum_of(const Camera& c) {
+  const glm::dvec3 f = glm::normalize(c.forward), r = glm::normalize(glm::cross(f, c.up)), u = glm::cross(r, f);
+  const double ty = std::tan(c.fov_y_deg * 3.14159265358979323846 / 360.0), tx = ty * c.width / c.height;
+  std::vector<ClipPlane> planes;
+  // Each side plane contains the eye and two corner rays; its normal points inwards.
+  const glm::dvec3 corners[4] = {f + r * tx + u * ty, f - r * tx + u * ty, f - r * tx - u * ty, f + r * tx - u * ty};
+  for (int k = 0; k < 4; ++k) {
+    glm::dvec3 n = glm::normalize(glm::cross(corners[k], corners[(k + 1) % 4]));
+    if (glm::dot(n, f) < 0) n = -n;
+    planes.push_back({n, -glm::dot(n, c.eye)});
+  }
+  planes.push_back({f, -glm::dot(f, c.eye) - c.near_plane});
+  return planes;
+}
+
+// A set of triangles (vertex positions and index triples).
+struct TriangleSoup {
+  std::vector<glm::dvec3> v;
+  std::vector<glm::u8vec4> c;
+  std::vector<std::uint32_t> t;
+  Poly3 triangle(std::size_t k) const { return {v[t[3 * k]], v[t[3 * k + 1]], v[t[3 * k + 2]]}; }
+  std::size_t size() const { return t.size() / 3; }
+};
+
+// The area of the frame's merged triangles within `planes`.
+inline double drawn_merged_area(const TerrainTree& tree, const Frame& f, const std::vector<ClipPlane>& planes = {}) {
+  double area = 0.0;
+  const auto& p = tree.positions();
+  for (std::size_t t = 0; t < f.level.size(); ++t) {
+    if (f.level[t] != kMergedLevel) continue;
+    area += polygon_area(clip_all({glm::dvec3(p[f.indices[3 * t]]), glm::dvec3(p[f.indices[3 * t + 1]]),
+                                   glm::dvec3(p[f.indices[3 * t + 2]])},
+                                  planes));
+  }
+  return area;
+}
+
+// What of `soup` an eye above the ground can see drawn with the frame's terrain, within
+// `planes`: inside the window, the parts above the terrain triangles the frame draws (each
+// clipped to its triangle's vertical prism and above its plane); outside the window's
+// footprint [x0, x1] x [y0, y1], everything.
+inline double area_above_drawn_terrain(const TerrainTree& tree, const Frame& f, const TriangleSoup& soup, double x0,
+                                       double x1, double y0, double y1, const std::vector<ClipPlane>& planes = {}) {
+  const auto& p = tree.positions();
+  double area = 0.0;
+  std::vector<ClipPlane> window = planes;
+  window.push_back({{1, 0, 0}, -x0});
+  window.push_back({{-1, 0, 0}, x1});
+  window.push_back({{0, 1, 0}, -y0});
+  window.push_back({{0, -1, 0}, y1});
+  for (std::size_t k = 0; k < soup.size(); ++k) {
+    area += polygon_area(clip_all(soup.triangle(k), planes)) - polygon_area(clip_all(soup.triangle(k), window));
+  }
+  for (std::size_t t = 0; t < f.level.size(); ++t) {
+    if (f.level[t] < 0) continue;  // terrain triangles only
+    const glm::dvec3 a(p[f.indices[3 * t]]), b(p[f.indices[3 * t + 1]]), c(p[f.indices[3 * t + 2]]);
+    glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    if (n.z < 0) n = -n;
+    std::vector<ClipPlane> prism = planes;
+    prism.push_back({n, -glm::dot(n, a)});
+    const glm::dvec3 centre = (a + b + c) / 3.0;
+    for (const auto& [e0, e1] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+      glm::dvec3 en = glm::normalize(glm::dvec3(-(e1.y - e0.y), e1.x - e0.x, 0.0));
+      if (glm::dot(en, centre - e0) < 0) en = -en;
+      prism.push_back({en, -glm::dot(en, e0)});
+    }
+    for (std::size_t k = 0; k < soup.size(); ++k) area += polygon_area(clip_all(soup.triangle(k), prism));
+  }
+  return area;
+}
+
+}  // namespace terravol::mrbsp::test
