@@ -533,7 +533,10 @@ class SlotBuilder {
   // range, the plane spanning the fewest of up to kSamples polygons spread through it, then the
   // most balanced. False when every polygon there is degenerate.
   bool choose(std::uint32_t begin, std::uint32_t end, PlaneD& best) const {
+    // Measured on the benchmark scene: 12 or 24 candidates store 5-7% fewer pieces for 20-50%
+    // more build time; weighting spans 2 or 32 times the imbalance stores 3-15% more.
     constexpr std::uint32_t kCandidates = 6, kSamples = 40;
+    constexpr double kW = 8.0;
     const std::uint32_t size = end - begin;
     const std::uint32_t candidates = std::min(size, kCandidates), samples = std::min(size, kSamples);
     double best_score = std::numeric_limits<double>::max();
@@ -550,7 +553,7 @@ class SlotBuilder {
           case Side::kCoplanar: break;
         }
       }
-      const double score = 8.0 * spans + std::abs(front - back);
+      const double score = kW * spans + std::abs(front - back);
       if (score < best_score) {
         best_score = score;
         best = plane;
@@ -682,29 +685,22 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   std::sort(dirty.begin(), dirty.end());
   dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
 
-  // Each dirty slot again from every surface's pieces there (in surface order), in parallel.
+  // Each dirty slot again from every surface's pieces there: above and outside slots built
+  // now (in parallel), low slots when first drawn.
   std::vector<Slot> fresh(dirty.size());
   tbb::parallel_for(std::size_t{0}, dirty.size(), [&](std::size_t k) {
-    fresh[k].key = dirty[k];
-    SlotBuilder builder(*this, fresh[k].store);
-    std::size_t pieces = 0;
-    for (std::uint32_t si = 0; si < surfaces.size(); ++si) {
-      const SurfacePieces& s = surfaces[si].second;
+    Slot& slot = fresh[k];
+    slot.key = dirty[k];
+    for (const auto& [id, s] : surfaces) {
       const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{dirty[k], 0, 0},
                                           [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
       for (auto it = range.first; it != range.second; ++it) {
-        builder.add(s, si, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
-        ++pieces;
+        ++slot.pending;
+        for (std::uint32_t r = 0; r < it->count; ++r) slot.top = std::max(slot.top, static_cast<float>(s.vertices[s.refs[it->first + r]].z));
       }
     }
-    if (pieces == 0) return;
-    if (dirty[k] >= kOutsideKey0 || dirty[k] % 2 == static_cast<SlotKey>(SlotKind::kAbove)) {
-      builder.build_autopartition();
-    } else {
-      const CellName c = cell_name(*this, static_cast<std::uint32_t>(dirty[k] / 2));
-      builder.build_low(c.level, c.ci, c.cj);
-    }
-    fresh[k].store.dropped = builder.dropped();
+    if (slot.pending == 0) return;
+    if (dirty[k] >= kOutsideKey0 || dirty[k] % 2 == static_cast<SlotKey>(SlotKind::kAbove)) build_store(slot);
   });
   // Merge into the sorted slots: clean ones kept, dirty ones replaced (or gone when empty).
   std::vector<Slot> merged;
@@ -715,7 +711,7 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
       merged.push_back(std::move(slots[a++]));
     } else {
       if (a < slots.size() && slots[a].key == fresh[b].key) ++a;
-      if (fresh[b].store.root >= 0) merged.push_back(std::move(fresh[b]));
+      if (fresh[b].pending > 0 || fresh[b].built) merged.push_back(std::move(fresh[b]));
       ++b;
     }
   }
@@ -732,6 +728,7 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   positions.reserve(merged_base() + vertices);
   merged_colors.reserve(vertices);
   for (Slot& slot : slots) {
+    if (!slot.built) continue;
     slot.store.base = static_cast<std::uint32_t>(positions.size());
     positions.insert(positions.end(), slot.store.positions.begin(), slot.store.positions.end());
     merged_colors.insert(merged_colors.end(), slot.store.colors.begin(), slot.store.colors.end());
@@ -762,7 +759,7 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
       }
       CellContent& c = record(static_cast<std::uint32_t>(key / 2));
       (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
-      c.top = std::max(c.top, slots[k].store.top);
+      c.top = std::max(c.top, slots[k].built ? slots[k].store.top : slots[k].top);
     }
     // Tops up the tree: every ancestor holds the highest content of its subtree.
     top_content.resize(static_cast<std::size_t>(top));
@@ -806,6 +803,12 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   }
   merge_stats.stored_polygons = pieces;
   merge_stats.slots = slots.size();
+  merge_stats.pending_slots = 0;
+  merge_stats.pending_pieces = 0;
+  for (const Slot& slot : slots) {
+    merge_stats.pending_slots += slot.built ? 0 : 1;
+    merge_stats.pending_pieces += slot.pending;
+  }
   merge_stats.merged_vertices = merged_colors.size();
   merge_stats.build_ms += ms_since(t0);
 }
@@ -838,6 +841,8 @@ void TerrainTree::Impl::redistribute_all() {
   const auto t0 = Clock::now();
   merge_stats.rebuilt_slots = 0;
   merge_stats.build_ms = 0.0;
+  merge_stats.lazy_built_slots = 0;
+  merge_stats.lazy_build_ms = 0.0;
   tbb::parallel_for(std::size_t{0}, surfaces.size(), [&](std::size_t k) { distribute(surfaces[k].second); });
   merge_stats.distribute_ms = ms_since(t0);
   std::vector<SlotKey> dirty;
@@ -854,6 +859,8 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   const auto t0 = Clock::now();
   m.merge_stats.rebuilt_slots = 0;
   m.merge_stats.build_ms = 0.0;
+  m.merge_stats.lazy_built_slots = 0;
+  m.merge_stats.lazy_build_ms = 0.0;
   std::vector<SlotKey> dirty;
   std::vector<std::size_t> changed;  // indices into m.surfaces to distribute
   for (std::size_t k = 0; k < ids.size(); ++k) {
@@ -904,6 +911,48 @@ MergeStats TerrainTree::merge(std::span<const glm::dvec3> vertices, std::span<co
   ids.push_back(0);
   inputs.push_back(input);
   return set_surfaces(ids, inputs);
+}
+
+bool TerrainTree::Impl::build_store(Slot& slot) const {
+  BspStore store;
+  SlotBuilder builder(*this, store);
+  std::size_t pieces = 0;
+  for (std::uint32_t si = 0; si < surfaces.size(); ++si) {
+    const SurfacePieces& s = surfaces[si].second;
+    const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{slot.key, 0, 0},
+                                        [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
+    for (auto it = range.first; it != range.second; ++it) {
+      builder.add(s, si, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+      ++pieces;
+    }
+  }
+  if (pieces == 0) return false;
+  if (slot.key >= kOutsideKey0 || slot.key % 2 == static_cast<SlotKey>(SlotKind::kAbove)) {
+    builder.build_autopartition();
+  } else {
+    const CellName c = cell_name(*this, static_cast<std::uint32_t>(slot.key / 2));
+    builder.build_low(c.level, c.ci, c.cj);
+  }
+  store.dropped = builder.dropped();
+  slot.store = std::move(store);
+  slot.built = true;
+  slot.pending = 0;
+  return true;
+}
+
+void TerrainTree::Impl::build_pending(std::size_t k) {
+  Slot& slot = slots[k];
+  const auto t0 = Clock::now();
+  build_store(slot);
+  slot.store.base = static_cast<std::uint32_t>(positions.size());
+  positions.insert(positions.end(), slot.store.positions.begin(), slot.store.positions.end());
+  merged_colors.insert(merged_colors.end(), slot.store.colors.begin(), slot.store.colors.end());
+  merge_stats.stored_polygons += slot.store.pieces;
+  merge_stats.dropped_pieces += slot.store.dropped;
+  merge_stats.merged_vertices = merged_colors.size();
+  --merge_stats.pending_slots;
+  ++merge_stats.lazy_built_slots;
+  merge_stats.lazy_build_ms += ms_since(t0);
 }
 
 const MergeStats& TerrainTree::merge_stats() const { return impl_->merge_stats; }

@@ -309,7 +309,8 @@ constexpr std::int32_t slot_of(std::uint64_t item) { return static_cast<std::int
 }  // namespace
 
 void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const {
-  const Impl& m = *impl_;
+  Impl& lazy = *impl_;  // builds the low alternatives it draws for the first time
+  const Impl& m = lazy;
   frame.indices.clear();
   frame.level.clear();
   frame.nodes_visited = 0;
@@ -439,6 +440,9 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
       if (eye_east) push_pair(west, east); else push_pair(east, west);
     } else {
+      if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
+        lazy.build_pending(static_cast<std::size_t>(content->low));
+      }
       stack.push_back(pack(kLeaf, level_index, ci, cj));
       frame.stamp_[m.cell_id(level, ci, cj)] = stamp;
       ++frame.lod_histogram[static_cast<std::size_t>(level)];

@@ -67,6 +67,10 @@ struct MergeStats {
   std::size_t stored_polygons = 0;  // merged pieces kept in the tree, all LOD copies counted
   std::size_t dropped_pieces = 0;   // pieces found below the terrain (never visible) and dropped
   std::size_t slots = 0;            // small BSPs
+  std::size_t pending_slots = 0;    // of those, low alternatives not built yet (built when first drawn)
+  std::size_t pending_pieces = 0;   // pieces waiting in them (before their BSPs split them)
+  std::size_t lazy_built_slots = 0; // low alternatives built by traversals since the last change
+  double lazy_build_ms = 0.0;       // what building those cost
   std::size_t merged_vertices = 0;  // vertices of the stored pieces (positions() after merged_base())
   std::size_t rebuilt_slots = 0;    // of the last change: small BSPs made again
   double distribute_ms = 0.0;       // of the last change: sending its surfaces through the tree
@@ -143,7 +147,10 @@ class TerrainTree {
   // vertical quads in the shared boundary plane hanging to the skirt-bottom vertices.
   // Culling (options.cull) tests each region's box holding everything drawn in it: its
   // terrain and the merged pieces kept in its subtree. The LOD choice uses the terrain's own
-  // box and error, so merging never changes which terrain is drawn.
+  // box and error, so merging never changes which terrain is drawn. A cell drawn low for the
+  // first time since the last merge gets its merged pieces built then (positions() and
+  // merged_colors() grow by its vertices; merge_stats() counts it): traverse() changes the
+  // tree's merged storage, so it must not run on two threads at once.
   void traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const;
 
   // Sliding (section 4.3): replace the heights and plane offsets for a window moved over the

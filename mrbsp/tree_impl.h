@@ -60,7 +60,7 @@ struct BspStore {
   std::uint32_t base = 0;       // where its vertices start in TerrainTree::positions()
   std::size_t pieces = 0;       // merged polygons (terrain triangles not counted)
   std::size_t dropped = 0;      // pieces found below the low triangles and dropped
-  float top = 0.0f;             // highest merged vertex
+  float top = -1e30f;           // highest merged vertex
   std::size_t bytes() const;
 };
 
@@ -103,8 +103,15 @@ struct SurfacePieces {
   std::size_t bytes() const;
 };
 
+// A slot and its small BSP. Above and outside slots are built when merged; low slots only
+// when a traversal first draws their cell low (most low alternatives of the coarse levels are
+// never drawn from inside the window), so until then `built` is false and `top` and `pending`
+// come from the pieces that arrived there.
 struct Slot {
   SlotKey key = 0;
+  bool built = false;
+  std::size_t pending = 0;  // pieces arrived, while not built
+  float top = 0.0f;         // highest vertex of the pieces arrived (the built store's is lower or equal)
   BspStore store;
 };
 
@@ -149,6 +156,10 @@ struct TerrainTree::Impl {
   // then the cell content and the merged vertices.
   void distribute(SurfacePieces& s) const;
   void rebuild(const std::vector<SlotKey>& dirty);
+  // Builds slots[k] (a low slot first drawn) and appends its vertices to positions.
+  void build_pending(std::size_t k);
+  // Builds a slot's store from every surface's pieces there; false when none arrived.
+  bool build_store(Slot& slot) const;
   void redistribute_all();  // after refresh(): every surface again, every slot
 };
 
