@@ -369,7 +369,9 @@ class SlotBuilder {
       }
       ids_.push_back(it->second);
     }
-    polys_.push_back({first, static_cast<std::uint32_t>(refs.size()), kMergedLevel});
+    Poly p{first, static_cast<std::uint32_t>(refs.size()), kMergedLevel};
+    p.flat = plane_of(p, p.plane);
+    polys_.push_back(p);
   }
 
   // An above or outside slot: an autopartition of the pieces.
@@ -408,7 +410,7 @@ class SlotBuilder {
       plane.d = -glm::dot(plane.n, p0);
       const std::int32_t node = new_node(plane);
       const std::uint32_t terrain = static_cast<std::uint32_t>(polys_.size());
-      polys_.push_back({static_cast<std::uint32_t>(ids_.size()), 3, static_cast<std::int8_t>(level)});
+      polys_.push_back({static_cast<std::uint32_t>(ids_.size()), 3, static_cast<std::int8_t>(level), true, plane});
       for (int k = 0; k < 3; ++k) ids_.push_back(kTerrainRef | t[k]);
       coplanar_.push_back({node, terrain});
       std::uint32_t below = 0, above = 0;
@@ -426,9 +428,12 @@ class SlotBuilder {
   std::size_t dropped() const { return dropped_; }
 
  private:
+  // A polygon while building; its plane computed once (split parts inherit it).
   struct Poly {
     std::uint32_t first, count;
     std::int8_t level;
+    bool flat = false;  // has a plane (not degenerate)
+    PlaneD plane{};
   };
 
   glm::dvec3 pos(std::uint32_t v) const {
@@ -437,8 +442,8 @@ class SlotBuilder {
 
   std::int32_t new_node(const PlaneD& p) {
     BspNode node;
-    node.n = p.n;
-    node.d = p.d;
+    node.n = glm::vec3(p.n);
+    node.d = static_cast<float>(p.d);
     out_.nodes.push_back(node);
     return static_cast<std::int32_t>(out_.nodes.size() - 1);
   }
@@ -507,12 +512,12 @@ class SlotBuilder {
               split_a_, split_b_);
           if (split_a_.size() >= 3) {
             back_list_.push_back(static_cast<std::uint32_t>(polys_.size()));
-            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_a_.size()), src.level});
+            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_a_.size()), src.level, src.flat, src.plane});
             ids_.insert(ids_.end(), split_a_.begin(), split_a_.end());
           }
           if (split_b_.size() >= 3) {
             front_list_.push_back(static_cast<std::uint32_t>(polys_.size()));
-            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_b_.size()), src.level});
+            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_b_.size()), src.level, src.flat, src.plane});
             ids_.insert(ids_.end(), split_b_.begin(), split_b_.end());
           }
           break;
@@ -538,12 +543,13 @@ class SlotBuilder {
     constexpr std::uint32_t kCandidates = 6, kSamples = 40;
     constexpr double kW = 8.0;
     const std::uint32_t size = end - begin;
-    const std::uint32_t candidates = std::min(size, kCandidates), samples = std::min(size, kSamples);
+    const std::uint32_t candidates = std::min(size, size <= 4 ? 2u : kCandidates), samples = std::min(size, kSamples);
     double best_score = std::numeric_limits<double>::max();
     bool found = false;
     for (std::uint32_t c = 0; c < candidates; ++c) {
-      PlaneD plane;
-      if (!plane_of(polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(c) * size / candidates)]], plane)) continue;
+      const Poly& candidate = polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(c) * size / candidates)]];
+      if (!candidate.flat) continue;
+      const PlaneD& plane = candidate.plane;
       int spans = 0, front = 0, back = 0;
       for (std::uint32_t k = 0; k < samples; ++k) {
         switch (classify(polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(k) * size / samples)]], plane)) {
@@ -562,7 +568,10 @@ class SlotBuilder {
     }
     if (found) return true;
     for (std::uint32_t k = begin; k < end; ++k) {
-      if (plane_of(polys_[list_[k]], best)) return true;
+      if (polys_[list_[k]].flat) {
+        best = polys_[list_[k]].plane;
+        return true;
+      }
     }
     return false;
   }
@@ -638,6 +647,7 @@ class SlotBuilder {
       }
       bn.count = static_cast<std::uint32_t>(out_.polys.size()) - bn.first;
     }
+    out_.vertex_count = static_cast<std::uint32_t>(out_.positions.size());
     out_.nodes.shrink_to_fit();
     out_.polys.shrink_to_fit();
     out_.refs.shrink_to_fit();
@@ -678,6 +688,17 @@ void release(std::vector<T>& v) {
 }  // namespace
 
 void TerrainTree::Impl::distribute(SurfacePieces& s) const { Distributor(*this, s).run(); }
+
+void ContentIndex::build(std::size_t cells, const std::vector<std::uint32_t>& sorted_cells) {
+  bits.assign((cells + 63) / 64, 0);
+  for (std::uint32_t c : sorted_cells) bits[c >> 6] |= std::uint64_t{1} << (c & 63u);
+  rank.resize(bits.size());
+  std::uint32_t count = 0;
+  for (std::size_t w = 0; w < bits.size(); ++w) {
+    rank[w] = count;
+    count += static_cast<std::uint32_t>(__builtin_popcountll(bits[w]));
+  }
+}
 
 void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   const auto t0 = Clock::now();
@@ -720,68 +741,82 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   if (surfaces.empty()) release(surfaces);
   merge_stats.rebuilt_slots += dirty.size();
 
-  // The merged vertices, slot after slot, and the cell content.
-  positions.resize(merged_base());
-  merged_colors.clear();
+  // The merged vertices, slot after slot: a slot built now brings its own, a clean one keeps
+  // what it had (copied from the old positions), and the cell content.
+  std::vector<glm::vec3> old_positions;
+  std::vector<glm::u8vec4> old_colors;
+  old_positions.swap(positions);
+  old_colors.swap(merged_colors);
   std::size_t vertices = 0, pieces = 0, dropped = 0;
-  for (const Slot& slot : slots) vertices += slot.store.positions.size();
+  for (const Slot& slot : slots) vertices += slot.built ? slot.store.vertex_count : 0;
   positions.reserve(merged_base() + vertices);
+  positions.assign(old_positions.begin(), old_positions.begin() + merged_base());
   merged_colors.reserve(vertices);
   for (Slot& slot : slots) {
     if (!slot.built) continue;
-    slot.store.base = static_cast<std::uint32_t>(positions.size());
-    positions.insert(positions.end(), slot.store.positions.begin(), slot.store.positions.end());
-    merged_colors.insert(merged_colors.end(), slot.store.colors.begin(), slot.store.colors.end());
-    pieces += slot.store.pieces;
-    dropped += slot.store.dropped;
+    BspStore& st = slot.store;
+    const std::uint32_t base = static_cast<std::uint32_t>(positions.size());
+    if (!st.positions.empty()) {
+      positions.insert(positions.end(), st.positions.begin(), st.positions.end());
+      merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
+      release(st.positions);
+      release(st.colors);
+    } else if (st.vertex_count > 0) {
+      positions.insert(positions.end(), old_positions.begin() + st.base, old_positions.begin() + st.base + st.vertex_count);
+      merged_colors.insert(merged_colors.end(), old_colors.begin() + (st.base - merged_base()),
+                           old_colors.begin() + (st.base - merged_base() + st.vertex_count));
+    }
+    st.base = base;
+    pieces += st.pieces;
+    dropped += st.dropped;
   }
-  positions.shrink_to_fit();
-  merged_colors.shrink_to_fit();
-  release(content_index);
+  release(old_positions);
+  release(old_colors);
+
+  // Cell content: every cell holding a slot and all its ancestors, in cell id order.
+  content_index = {};
   release(content);
   release(top_content);
   std::fill(std::begin(outside), std::end(outside), -1);
-  if (!slots.empty()) {
-    content_index.assign(total_cells, -1);
-    const auto record = [&](std::uint32_t cell) -> CellContent& {
-      std::int32_t& c = content_index[cell];
-      if (c < 0) {
-        c = static_cast<std::int32_t>(content.size());
-        content.push_back({-1, -1, -std::numeric_limits<float>::infinity()});
-      }
-      return content[static_cast<std::size_t>(c)];
-    };
+  std::vector<std::uint32_t> cells;
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    const SlotKey key = slots[k].key;
+    if (key >= kOutsideKey0) {
+      outside[key - kOutsideKey0] = static_cast<std::int32_t>(k);
+      continue;
+    }
+    CellName c = cell_name(*this, key / 2);
+    for (; c.level >= 0; --c.level, c.ci /= 2, c.cj /= 2) cells.push_back(cell_id(c.level, c.ci, c.cj));
+  }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  if (!cells.empty()) {
+    content_index.build(total_cells, cells);
+    content.assign(cells.size(), {-1, -1, -std::numeric_limits<float>::infinity()});
     for (std::size_t k = 0; k < slots.size(); ++k) {
       const SlotKey key = slots[k].key;
-      if (key >= kOutsideKey0) {
-        outside[key - kOutsideKey0] = static_cast<std::int32_t>(k);
-        continue;
-      }
-      CellContent& c = record(static_cast<std::uint32_t>(key / 2));
+      if (key >= kOutsideKey0) continue;
+      CellContent& c = content[static_cast<std::size_t>(content_index.find(key / 2))];
       (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
       c.top = std::max(c.top, slots[k].built ? slots[k].store.top : slots[k].top);
     }
-    // Tops up the tree: every ancestor holds the highest content of its subtree.
+    // Tops up the tree, finest first (cell ids grow with the level): every ancestor holds the
+    // highest content of its subtree; the top levels in top_content.
     top_content.resize(static_cast<std::size_t>(top));
     for (int l = -top; l < 0; ++l) {
       top_content[static_cast<std::size_t>(l + top)].assign(static_cast<std::size_t>(cells_at(l)) * static_cast<std::size_t>(cells_at(l)),
                                                            -std::numeric_limits<float>::infinity());
     }
-    for (int level = levels - 1; level >= 0; --level) {
-      const int c = cells_at(level);
-      for (int cj = 0; cj < c; ++cj)
-        for (int ci = 0; ci < c; ++ci) {
-          const std::int32_t idx = content_index[cell_id(level, ci, cj)];
-          if (idx < 0) continue;
-          const float t = content[static_cast<std::size_t>(idx)].top;
-          if (level > 0) {
-            CellContent& parent = record(cell_id(level - 1, ci / 2, cj / 2));
-            parent.top = std::max(parent.top, t);
-          } else if (top > 0) {
-            float& p = top_content[static_cast<std::size_t>(top - 1)][static_cast<std::size_t>((cj / 2) * cells_at(-1) + ci / 2)];
-            p = std::max(p, t);
-          }
-        }
+    for (std::size_t k = cells.size(); k-- > 0;) {
+      const CellName c = cell_name(*this, cells[k]);
+      const float t = content[k].top;
+      if (c.level > 0) {
+        CellContent& parent = content[static_cast<std::size_t>(content_index.find(cell_id(c.level - 1, c.ci / 2, c.cj / 2)))];
+        parent.top = std::max(parent.top, t);
+      } else if (top > 0) {
+        float& p = top_content[static_cast<std::size_t>(top - 1)][static_cast<std::size_t>((c.cj / 2) * cells_at(-1) + c.ci / 2)];
+        p = std::max(p, t);
+      }
     }
     for (int l = -1; l > -top; --l) {
       const int c = cells_at(l);
@@ -792,7 +827,6 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
           p = std::max(p, t);
         }
     }
-    content.shrink_to_fit();
   }
   merge_stats.surfaces = surfaces.size();
   merge_stats.input_triangles = 0;
@@ -944,9 +978,12 @@ void TerrainTree::Impl::build_pending(std::size_t k) {
   Slot& slot = slots[k];
   const auto t0 = Clock::now();
   build_store(slot);
-  slot.store.base = static_cast<std::uint32_t>(positions.size());
-  positions.insert(positions.end(), slot.store.positions.begin(), slot.store.positions.end());
-  merged_colors.insert(merged_colors.end(), slot.store.colors.begin(), slot.store.colors.end());
+  BspStore& st = slot.store;
+  st.base = static_cast<std::uint32_t>(positions.size());
+  positions.insert(positions.end(), st.positions.begin(), st.positions.end());
+  merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
+  release(st.positions);
+  release(st.colors);
   merge_stats.stored_polygons += slot.store.pieces;
   merge_stats.dropped_pieces += slot.store.dropped;
   merge_stats.merged_vertices = merged_colors.size();

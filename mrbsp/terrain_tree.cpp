@@ -222,7 +222,7 @@ MemoryStats TerrainTree::memory() const {
   const std::size_t terrain = std::min<std::size_t>(m.merged_base(), m.positions.capacity());
   s.vertices = terrain * sizeof(glm::vec3);
   s.merged = held(m.positions) - s.vertices + held(m.merged_colors) + held(m.surfaces) + held(m.slots) +
-             held(m.content_index) + held(m.content) + held(m.top_content);
+             held(m.content_index.bits) + held(m.content_index.rank) + held(m.content) + held(m.top_content);
   for (const auto& [id, surface] : m.surfaces) s.merged += surface.bytes();
   for (const Slot& slot : m.slots) s.merged += slot.store.bytes();
   for (const auto& level : m.top_content) s.merged += held(level);
@@ -340,7 +340,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     if (level < 0) return m.top_content.empty() ? -std::numeric_limits<float>::infinity()
                                                 : m.top_content[static_cast<std::size_t>(level + m.top)][static_cast<std::size_t>(cj * m.cells_at(level) + ci)];
     if (m.content_index.empty()) return -std::numeric_limits<float>::infinity();
-    const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+    const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
     return c < 0 ? -std::numeric_limits<float>::infinity() : m.content[static_cast<std::size_t>(c)].top;
   };
 
@@ -424,7 +424,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         }
       }
       if (!m.content_index.empty()) {
-        const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+        const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
         if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
       }
     }
@@ -517,7 +517,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         continue;
       }
       const BspNode& bn = store.nodes[static_cast<std::size_t>(top)];
-      const bool eye_front = glm::dot(bn.n, e) + bn.d >= 0.0;
+      const bool eye_front = glm::dot(glm::dvec3(bn.n), e) + static_cast<double>(bn.d) >= 0.0;
       const std::int32_t far_side = eye_front ? bn.back : bn.front, near_side = eye_front ? bn.front : bn.back;
       const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
       if (second >= 0) st.push_back(second);
@@ -555,7 +555,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
 
     const CellContent* content = nullptr;
     if (!m.content_index.empty()) {
-      const std::int32_t c = m.content_index[m.cell_id(level, ci, cj)];
+      const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
       if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
     }
     if (content && content->low >= 0) {

@@ -40,24 +40,28 @@ struct Polygon {
 inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 
 // A node of a small BSP (section 4.2, "in a terrain leaf" and above the terrain): the plane
-// n.p + d = 0, the polygons lying in it, and the two sides (-1 when empty).
+// n.p + d = 0, the polygons lying in it, and the two sides (-1 when empty). The plane is kept
+// in single precision (the pieces were split against it in double): it only tells the eye's
+// side, wrong at most for an eye within millimetres of it, where either order draws the same.
 struct BspNode {
-  glm::dvec3 n{0.0};
-  double d = 0.0;
+  glm::vec3 n{0.0f};
+  float d = 0.0f;
   std::int32_t back = -1, front = -1;
   std::uint32_t first = 0, count = 0;  // into the store's polys
 };
 
-// The small BSPs of one slot, self-contained: nodes, polygons, references and its own copies
-// of the vertices it uses (float, as drawn, with their RGBA).
+// The small BSPs of one slot: nodes, polygons and references. Its vertices (float, as drawn,
+// with their RGBA) are made in `positions` and `colors`, then moved into the tree's merged
+// vertices, where they are vertices [base, base + vertex_count).
 struct BspStore {
   std::vector<BspNode> nodes;
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
-  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> positions;  // empty once moved into the tree
   std::vector<glm::u8vec4> colors;
   std::int32_t root = -1;
   std::uint32_t base = 0;       // where its vertices start in TerrainTree::positions()
+  std::uint32_t vertex_count = 0;
   std::size_t pieces = 0;       // merged polygons (terrain triangles not counted)
   std::size_t dropped = 0;      // pieces found below the low triangles and dropped
   float top = -1e30f;           // highest merged vertex
@@ -73,9 +77,24 @@ struct BspStore {
 enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
 
 // A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
-// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north).
-using SlotKey = std::uint64_t;
-inline constexpr SlotKey kOutsideKey0 = std::uint64_t{1} << 62;
+// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north). Cells number at most 1.5e9 (a
+// 32768-cell window), so keys fit 32 bits below kOutsideKey0.
+using SlotKey = std::uint32_t;
+inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFF0u;
+
+// Which cells hold merged content, and where its record is: a bit per cell and the count of
+// set bits before each 64-bit word (rank), so a record is found in O(1) with 1.5 bits per cell.
+struct ContentIndex {
+  std::vector<std::uint64_t> bits;
+  std::vector<std::uint32_t> rank;
+  void build(std::size_t cells, const std::vector<std::uint32_t>& sorted_cells);
+  bool empty() const { return bits.empty(); }
+  std::int32_t find(std::uint32_t cell) const {
+    const std::uint64_t word = bits[cell >> 6], bit = std::uint64_t{1} << (cell & 63u);
+    if (!(word & bit)) return -1;
+    return static_cast<std::int32_t>(rank[cell >> 6] + static_cast<std::uint32_t>(__builtin_popcountll(word & (bit - 1))));
+  }
+};
 
 // What a cell's subtree holds of merged content, for cells that hold any (sparse).
 struct CellContent {
@@ -97,6 +116,7 @@ struct SurfacePieces {
     std::uint32_t first;  // into refs
     std::uint32_t count;
   };
+  static_assert(sizeof(Piece) == 12);
   std::vector<Piece> pieces;  // sorted by slot, stable
   std::vector<std::uint32_t> refs;
   std::size_t dropped = 0;  // pieces found below the terrain and dropped
@@ -131,8 +151,8 @@ struct TerrainTree::Impl {
   // levels by level and index in top_content).
   std::vector<std::pair<std::uint32_t, SurfacePieces>> surfaces;  // sorted by id
   std::vector<Slot> slots;                                           // sorted by key
-  std::vector<std::int32_t> content_index;                           // per global cell id: into content, or -1
-  std::vector<CellContent> content;
+  ContentIndex content_index;        // cells with content -> their record in `content`
+  std::vector<CellContent> content;  // in cell id order
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
   std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
   std::vector<glm::u8vec4> merged_colors;
