@@ -349,7 +349,9 @@ class Distributor {
 
 // --- Small BSPs -------------------------------------------------------------------------------
 
-// Builds one slot's store from the pieces that arrived there (of every surface).
+// Builds a slot's small BSP from pieces that arrived there, or inserts more pieces into the one
+// it has (ordinary BSP insertion, Fuchs, Kedem and Naylor 1980: down the existing planes,
+// split where they span, a new autopartition where an empty side is reached).
 class SlotBuilder {
  public:
   SlotBuilder(const TerrainTree::Impl& m, BspStore& out) : m_(m), out_(out) {
@@ -357,11 +359,11 @@ class SlotBuilder {
     eps_ = 1e-9 * std::max(size, 1.0);
   }
 
-  // Adds a piece of `surface` (its vertex ids) to the slot.
-  void add(const SurfacePieces& surface, std::uint32_t surface_index, std::span<const std::uint32_t> refs) {
+  // Adds a piece of `surface` (its vertex ids) to what is built or inserted.
+  void add(const SurfacePieces& surface, std::uint32_t surface_id, std::span<const std::uint32_t> refs) {
     const std::uint32_t first = static_cast<std::uint32_t>(ids_.size());
     for (std::uint32_t v : refs) {
-      const std::uint64_t key = static_cast<std::uint64_t>(surface_index) << 32 | v;
+      const std::uint64_t key = static_cast<std::uint64_t>(surface_id) << 32 | v;
       const auto [it, fresh] = local_.try_emplace(key, static_cast<std::uint32_t>(pos_.size()));
       if (fresh) {
         pos_.push_back(surface.vertices[v]);
@@ -369,22 +371,32 @@ class SlotBuilder {
       }
       ids_.push_back(it->second);
     }
-    Poly p{first, static_cast<std::uint32_t>(refs.size()), kMergedLevel};
+    Poly p{first, static_cast<std::uint32_t>(refs.size()), kMergedLevel, false, {}, surface_id};
     p.flat = plane_of(p, p.plane);
     polys_.push_back(p);
   }
 
-  // An above or outside slot: an autopartition of the pieces.
+  // An above or outside slot: an autopartition of the pieces, or their insertion.
   void build_autopartition() {
-    list_.clear();
-    for (std::uint32_t p = 0; p < polys_.size(); ++p) list_.push_back(p);
-    out_.root = build(0, static_cast<std::uint32_t>(list_.size()));
+    all_polys();
+    if (out_.root >= 0) {
+      insert();
+    } else {
+      out_.root = build(0, static_cast<std::uint32_t>(list_.size()));
+    }
     finish();
   }
 
   // A low slot of cell (level, ci, cj): the diagonal plane; on each side the terrain triangle's
-  // plane with the triangle in it, the pieces above it in an autopartition, those below dropped.
+  // plane with the triangle in it, the pieces above it in an autopartition, those below dropped
+  // (kDropSide). Into an existing one, an insertion.
   void build_low(int level, int ci, int cj) {
+    all_polys();
+    if (out_.root >= 0) {
+      insert();
+      finish();
+      return;
+    }
     const int s = m_.cell_size(level);
     const std::uint32_t sw = m_.vertex(ci * s, cj * s), se = m_.vertex(ci * s + s, cj * s);
     const std::uint32_t ne = m_.vertex(ci * s + s, cj * s + s), nw = m_.vertex(ci * s, cj * s + s);
@@ -392,8 +404,6 @@ class SlotBuilder {
     PlaneD diag;
     diag.n = glm::normalize(glm::dvec3(-(c.y - a.y), c.x - a.x, 0.0));  // negative on the south-east side
     diag.d = -glm::dot(diag.n, a);
-    list_.clear();
-    for (std::uint32_t p = 0; p < polys_.size(); ++p) list_.push_back(p);
     const std::uint32_t total = static_cast<std::uint32_t>(list_.size());
     const std::int32_t root = new_node(diag);
     std::uint32_t nb = 0, nf = 0;
@@ -409,14 +419,16 @@ class SlotBuilder {
       plane.n = glm::normalize(glm::cross(p1 - p0, p2 - p0));  // counter-clockwise from above: up
       plane.d = -glm::dot(plane.n, p0);
       const std::int32_t node = new_node(plane);
+      out_.nodes[static_cast<std::size_t>(node)].back = kDropSide;
       const std::uint32_t terrain = static_cast<std::uint32_t>(polys_.size());
-      polys_.push_back({static_cast<std::uint32_t>(ids_.size()), 3, static_cast<std::int8_t>(level), true, plane});
+      polys_.push_back({static_cast<std::uint32_t>(ids_.size()), 3, static_cast<std::int8_t>(level), true, plane, kTerrainSurface});
       for (int k = 0; k < 3; ++k) ids_.push_back(kTerrainRef | t[k]);
       coplanar_.push_back({node, terrain});
       std::uint32_t below = 0, above = 0;
       partition(begin[side], end[side], plane, node, below, above);
       dropped_ += below;  // under the drawn triangle: hidden from every eye above the ground
-      out_.nodes[static_cast<std::size_t>(node)].front = build(begin[side] + below, begin[side] + below + above);
+      const std::int32_t upper = build(begin[side] + below, begin[side] + below + above);
+      out_.nodes[static_cast<std::size_t>(node)].front = upper;
       sides[side] = node;
     }
     out_.nodes[static_cast<std::size_t>(root)].back = sides[0];
@@ -434,11 +446,18 @@ class SlotBuilder {
     std::int8_t level;
     bool flat = false;  // has a plane (not degenerate)
     PlaneD plane{};
+    std::uint32_t surface = 0;
   };
+
+  void all_polys() {
+    list_.clear();
+    for (std::uint32_t p = 0; p < polys_.size(); ++p) list_.push_back(p);
+  }
 
   glm::dvec3 pos(std::uint32_t v) const {
     return (v & kTerrainRef) ? glm::dvec3(m_.positions[v & ~kTerrainRef]) : pos_[v];
   }
+  glm::u8vec4 color(std::uint32_t v) const { return (v & kTerrainRef) ? glm::u8vec4(255) : col_[v]; }
 
   std::int32_t new_node(const PlaneD& p) {
     BspNode node;
@@ -510,15 +529,12 @@ class SlotBuilder {
                 });
               },
               split_a_, split_b_);
-          if (split_a_.size() >= 3) {
-            back_list_.push_back(static_cast<std::uint32_t>(polys_.size()));
-            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_a_.size()), src.level, src.flat, src.plane});
-            ids_.insert(ids_.end(), split_a_.begin(), split_a_.end());
-          }
-          if (split_b_.size() >= 3) {
-            front_list_.push_back(static_cast<std::uint32_t>(polys_.size()));
-            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(split_b_.size()), src.level, src.flat, src.plane});
-            ids_.insert(ids_.end(), split_b_.begin(), split_b_.end());
+          for (auto* part : {&split_a_, &split_b_}) {
+            if (part->size() < 3) continue;
+            (part == &split_a_ ? back_list_ : front_list_).push_back(static_cast<std::uint32_t>(polys_.size()));
+            polys_.push_back({static_cast<std::uint32_t>(ids_.size()), static_cast<std::uint32_t>(part->size()), src.level,
+                              src.flat, src.plane, src.surface});
+            ids_.insert(ids_.end(), part->begin(), part->end());
           }
           break;
         }
@@ -531,8 +547,6 @@ class SlotBuilder {
     std::copy(back_list_.begin(), back_list_.end(), list_.begin() + begin);
     std::copy(front_list_.begin(), front_list_.end(), list_.begin() + begin + nb);
   }
-
-  glm::u8vec4 color(std::uint32_t v) const { return (v & kTerrainRef) ? glm::u8vec4(255) : col_[v]; }
 
   // The splitter for list_[begin, end): among up to kCandidates polygons spread through the
   // range, the plane spanning the fewest of up to kSamples polygons spread through it, then the
@@ -611,24 +625,67 @@ class SlotBuilder {
     return root;
   }
 
-  // Writes the coplanar lists into the store's polygons and refs, keeping only the vertices
-  // used, as floats.
+  // Inserts list_ into the existing BSP: each task carries its own list, since new subtrees
+  // (build) use list_ as their stack.
+  void insert() {
+    struct Task {
+      std::int32_t node;
+      std::vector<std::uint32_t> list;
+    };
+    std::vector<Task> tasks;
+    tasks.push_back({out_.root, list_});
+    while (!tasks.empty()) {
+      Task t = std::move(tasks.back());
+      tasks.pop_back();
+      const BspNode bn = out_.nodes[static_cast<std::size_t>(t.node)];
+      const PlaneD plane{glm::dvec3(bn.n), static_cast<double>(bn.d)};
+      list_ = std::move(t.list);
+      std::uint32_t nb = 0, nf = 0;
+      partition(0, static_cast<std::uint32_t>(list_.size()), plane, t.node, nb, nf);
+      std::vector<std::uint32_t> sides[2] = {std::vector<std::uint32_t>(list_.begin(), list_.begin() + nb),
+                                             std::vector<std::uint32_t>(list_.begin() + nb, list_.begin() + nb + nf)};
+      for (int side = 0; side < 2; ++side) {
+        if (sides[side].empty()) continue;
+        const std::int32_t child = side == 0 ? bn.back : bn.front;
+        if (child == kDropSide) {
+          dropped_ += sides[side].size();
+        } else if (child >= 0) {
+          tasks.push_back({child, std::move(sides[side])});
+        } else {
+          list_ = std::move(sides[side]);
+          const std::int32_t sub = build(0, static_cast<std::uint32_t>(list_.size()));
+          BspNode& parent = out_.nodes[static_cast<std::size_t>(t.node)];
+          (side == 0 ? parent.back : parent.front) = sub;
+        }
+      }
+    }
+  }
+
+  // Lays out every node's polygons again: its old ones, then those added now (with new
+  // references: kTerrainRef | lattice vertex, or an index into the staged vertices, of which
+  // only those used are kept, as floats).
   void finish() {
     std::stable_sort(coplanar_.begin(), coplanar_.end(),
                      [](const std::pair<std::int32_t, std::uint32_t>& a, const std::pair<std::int32_t, std::uint32_t>& b) {
                        return a.first < b.first;
                      });
+    std::vector<Polygon> old = std::move(out_.polys);
+    out_.polys.clear();
+    out_.polys.reserve(old.size() + coplanar_.size());
+    out_.staged_refs = static_cast<std::uint32_t>(out_.refs.size());
     std::vector<std::uint32_t> remap(pos_.size(), std::numeric_limits<std::uint32_t>::max());
     std::size_t c = 0;
     for (std::size_t node = 0; node < out_.nodes.size(); ++node) {
       BspNode& bn = out_.nodes[node];
-      bn.first = static_cast<std::uint32_t>(out_.polys.size());
+      const std::uint32_t first = static_cast<std::uint32_t>(out_.polys.size());
+      out_.polys.insert(out_.polys.end(), old.begin() + bn.first, old.begin() + bn.first + bn.count);
       for (; c < coplanar_.size() && coplanar_[c].first == static_cast<std::int32_t>(node); ++c) {
         const Poly& p = polys_[coplanar_[c].second];
         Polygon q;
         q.first = static_cast<std::uint32_t>(out_.refs.size());
         q.count = static_cast<std::uint16_t>(p.count);
         q.level = p.level;
+        q.surface = p.surface;
         for (std::uint32_t k = 0; k < p.count; ++k) {
           std::uint32_t v = ids_[p.first + k];
           if (!(v & kTerrainRef)) {
@@ -645,14 +702,13 @@ class SlotBuilder {
         out_.polys.push_back(q);
         if (p.level == kMergedLevel) ++out_.pieces;
       }
-      bn.count = static_cast<std::uint32_t>(out_.polys.size()) - bn.first;
+      bn.first = first;
+      bn.count = static_cast<std::uint32_t>(out_.polys.size()) - first;
     }
-    out_.vertex_count = static_cast<std::uint32_t>(out_.positions.size());
+    out_.dropped += dropped_;
     out_.nodes.shrink_to_fit();
     out_.polys.shrink_to_fit();
     out_.refs.shrink_to_fit();
-    out_.positions.shrink_to_fit();
-    out_.colors.shrink_to_fit();
   }
 
   const TerrainTree::Impl& m_;
@@ -685,6 +741,50 @@ void release(std::vector<T>& v) {
   std::vector<T>().swap(v);
 }
 
+bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
+
+// The pieces of surface `s` that arrived at slot `key`.
+std::pair<const SurfacePieces::Piece*, const SurfacePieces::Piece*> arrivals(const SurfacePieces& s, SlotKey key) {
+  const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{key, 0, 0},
+                                      [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
+  return {s.pieces.data() + (range.first - s.pieces.begin()), s.pieces.data() + (range.second - s.pieces.begin())};
+}
+
+// Removes the polygons of the surfaces in `ids` (sorted) from a store; returns the references
+// dropped with them. Its top becomes that of what stays.
+std::size_t remove_surfaces(BspStore& st, const std::vector<std::uint32_t>& ids, const std::vector<glm::vec3>& positions) {
+  std::vector<Polygon> polys;
+  std::vector<std::uint32_t> refs;
+  polys.reserve(st.polys.size());
+  refs.reserve(st.refs.size());
+  st.pieces = 0;
+  st.top = -1e30f;
+  for (BspNode& bn : st.nodes) {
+    const std::uint32_t first = static_cast<std::uint32_t>(polys.size());
+    for (std::uint32_t k = bn.first; k < bn.first + bn.count; ++k) {
+      Polygon p = st.polys[k];
+      if (p.surface != kTerrainSurface && std::binary_search(ids.begin(), ids.end(), p.surface)) continue;
+      const std::uint32_t from = p.first;
+      p.first = static_cast<std::uint32_t>(refs.size());
+      refs.insert(refs.end(), st.refs.begin() + from, st.refs.begin() + from + p.count);
+      if (p.surface != kTerrainSurface) {
+        ++st.pieces;
+        for (std::uint32_t r = p.first; r < p.first + p.count; ++r) st.top = std::max(st.top, positions[refs[r]].z);
+      }
+      polys.push_back(p);
+    }
+    bn.first = first;
+    bn.count = static_cast<std::uint32_t>(polys.size()) - first;
+  }
+  const std::size_t removed = st.refs.size() - refs.size();
+  refs.shrink_to_fit();
+  polys.shrink_to_fit();
+  st.refs = std::move(refs);
+  st.polys = std::move(polys);
+  st.staged_refs = static_cast<std::uint32_t>(st.refs.size());
+  return removed;
+}
+
 }  // namespace
 
 void TerrainTree::Impl::distribute(SurfacePieces& s) const { Distributor(*this, s).run(); }
@@ -700,80 +800,51 @@ void ContentIndex::build(std::size_t cells, const std::vector<std::uint32_t>& so
   }
 }
 
-void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
-  const auto t0 = Clock::now();
-  std::vector<SlotKey> dirty = dirty_in;
-  std::sort(dirty.begin(), dirty.end());
-  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
-
-  // Each dirty slot again from every surface's pieces there: above and outside slots built
-  // now (in parallel), low slots when first drawn.
-  std::vector<Slot> fresh(dirty.size());
-  tbb::parallel_for(std::size_t{0}, dirty.size(), [&](std::size_t k) {
-    Slot& slot = fresh[k];
-    slot.key = dirty[k];
-    for (const auto& [id, s] : surfaces) {
-      const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{dirty[k], 0, 0},
-                                          [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
-      for (auto it = range.first; it != range.second; ++it) {
-        ++slot.pending;
-        for (std::uint32_t r = 0; r < it->count; ++r) slot.top = std::max(slot.top, static_cast<float>(s.vertices[s.refs[it->first + r]].z));
-      }
-    }
-    if (slot.pending == 0) return;
-    if (dirty[k] >= kOutsideKey0 || dirty[k] % 2 == static_cast<SlotKey>(SlotKind::kAbove)) build_store(slot);
-  });
-  // Merge into the sorted slots: clean ones kept, dirty ones replaced (or gone when empty).
-  std::vector<Slot> merged;
-  merged.reserve(slots.size() + fresh.size());
-  std::size_t a = 0, b = 0;
-  while (a < slots.size() || b < fresh.size()) {
-    if (b == fresh.size() || (a < slots.size() && slots[a].key < fresh[b].key)) {
-      merged.push_back(std::move(slots[a++]));
-    } else {
-      if (a < slots.size() && slots[a].key == fresh[b].key) ++a;
-      if (fresh[b].pending > 0 || fresh[b].built) merged.push_back(std::move(fresh[b]));
-      ++b;
-    }
+void TerrainTree::Impl::flush(BspStore& st) {
+  const auto base = static_cast<std::uint32_t>(positions.size());
+  if (positions.capacity() < positions.size() + st.positions.size()) {
+    // Grown by a quarter, not doubled: lazily built slots arrive one by one.
+    const std::size_t want = std::max(positions.size() + st.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
+    positions.reserve(want);
+    merged_colors.reserve(want - merged_base());
   }
-  slots = std::move(merged);
-  slots.shrink_to_fit();
-  if (surfaces.empty()) release(surfaces);
-  merge_stats.rebuilt_slots += dirty.size();
+  positions.insert(positions.end(), st.positions.begin(), st.positions.end());
+  merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
+  for (std::size_t r = st.staged_refs; r < st.refs.size(); ++r) {
+    const std::uint32_t v = st.refs[r];
+    st.refs[r] = (v & kTerrainRef) ? (v & ~kTerrainRef) : base + v;
+  }
+  st.staged_refs = static_cast<std::uint32_t>(st.refs.size());
+  release(st.positions);
+  release(st.colors);
+}
 
-  // The merged vertices, slot after slot: a slot built now brings its own, a clean one keeps
-  // what it had (copied from the old positions), and the cell content.
-  std::vector<glm::vec3> old_positions;
-  std::vector<glm::u8vec4> old_colors;
-  old_positions.swap(positions);
-  old_colors.swap(merged_colors);
-  std::size_t vertices = 0, pieces = 0, dropped = 0;
-  for (const Slot& slot : slots) vertices += slot.built ? slot.store.vertex_count : 0;
-  positions.reserve(merged_base() + vertices);
-  positions.assign(old_positions.begin(), old_positions.begin() + merged_base());
-  merged_colors.reserve(vertices);
+void TerrainTree::Impl::compact() {
+  const std::uint32_t base = merged_base();
+  std::vector<std::uint32_t> remap(positions.size() - base, std::numeric_limits<std::uint32_t>::max());
+  std::vector<glm::vec3> kept_positions(positions.begin(), positions.begin() + base);
+  std::vector<glm::u8vec4> kept_colors;
   for (Slot& slot : slots) {
-    if (!slot.built) continue;
-    BspStore& st = slot.store;
-    const std::uint32_t base = static_cast<std::uint32_t>(positions.size());
-    if (!st.positions.empty()) {
-      positions.insert(positions.end(), st.positions.begin(), st.positions.end());
-      merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
-      release(st.positions);
-      release(st.colors);
-    } else if (st.vertex_count > 0) {
-      positions.insert(positions.end(), old_positions.begin() + st.base, old_positions.begin() + st.base + st.vertex_count);
-      merged_colors.insert(merged_colors.end(), old_colors.begin() + (st.base - merged_base()),
-                           old_colors.begin() + (st.base - merged_base() + st.vertex_count));
+    for (std::uint32_t& v : slot.store.refs) {
+      if (v < base) continue;
+      std::uint32_t& r = remap[v - base];
+      if (r == std::numeric_limits<std::uint32_t>::max()) {
+        r = static_cast<std::uint32_t>(kept_positions.size());
+        kept_positions.push_back(positions[v]);
+        kept_colors.push_back(merged_colors[v - base]);
+      }
+      v = r;
     }
-    st.base = base;
-    pieces += st.pieces;
-    dropped += st.dropped;
   }
-  release(old_positions);
-  release(old_colors);
+  kept_positions.shrink_to_fit();
+  kept_colors.shrink_to_fit();
+  positions = std::move(kept_positions);
+  merged_colors = std::move(kept_colors);
+  dead_refs = 0;
+  ++merged_version;
+}
 
-  // Cell content: every cell holding a slot and all its ancestors, in cell id order.
+void TerrainTree::Impl::make_content() {
   content_index = {};
   release(content);
   release(top_content);
@@ -790,66 +861,169 @@ void TerrainTree::Impl::rebuild(const std::vector<SlotKey>& dirty_in) {
   }
   std::sort(cells.begin(), cells.end());
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-  if (!cells.empty()) {
-    content_index.build(total_cells, cells);
-    content.assign(cells.size(), {-1, -1, -std::numeric_limits<float>::infinity()});
-    for (std::size_t k = 0; k < slots.size(); ++k) {
-      const SlotKey key = slots[k].key;
-      if (key >= kOutsideKey0) continue;
-      CellContent& c = content[static_cast<std::size_t>(content_index.find(key / 2))];
-      (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
-      c.top = std::max(c.top, slots[k].built ? slots[k].store.top : slots[k].top);
-    }
-    // Tops up the tree, finest first (cell ids grow with the level): every ancestor holds the
-    // highest content of its subtree; the top levels in top_content.
-    top_content.resize(static_cast<std::size_t>(top));
-    for (int l = -top; l < 0; ++l) {
-      top_content[static_cast<std::size_t>(l + top)].assign(static_cast<std::size_t>(cells_at(l)) * static_cast<std::size_t>(cells_at(l)),
-                                                           -std::numeric_limits<float>::infinity());
-    }
-    for (std::size_t k = cells.size(); k-- > 0;) {
-      const CellName c = cell_name(*this, cells[k]);
-      const float t = content[k].top;
-      if (c.level > 0) {
-        CellContent& parent = content[static_cast<std::size_t>(content_index.find(cell_id(c.level - 1, c.ci / 2, c.cj / 2)))];
-        parent.top = std::max(parent.top, t);
-      } else if (top > 0) {
-        float& p = top_content[static_cast<std::size_t>(top - 1)][static_cast<std::size_t>((c.cj / 2) * cells_at(-1) + c.ci / 2)];
-        p = std::max(p, t);
-      }
-    }
-    for (int l = -1; l > -top; --l) {
-      const int c = cells_at(l);
-      for (int cj = 0; cj < c; ++cj)
-        for (int ci = 0; ci < c; ++ci) {
-          const float t = top_content[static_cast<std::size_t>(l + top)][static_cast<std::size_t>(cj * c + ci)];
-          float& p = top_content[static_cast<std::size_t>(l - 1 + top)][static_cast<std::size_t>((cj / 2) * cells_at(l - 1) + ci / 2)];
-          p = std::max(p, t);
-        }
+  if (cells.empty()) return;
+  content_index.build(total_cells, cells);
+  content.assign(cells.size(), {-1, -1, -std::numeric_limits<float>::infinity()});
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    const SlotKey key = slots[k].key;
+    if (key >= kOutsideKey0) continue;
+    CellContent& c = content[static_cast<std::size_t>(content_index.find(key / 2))];
+    (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
+    c.top = std::max(c.top, slots[k].built ? slots[k].store.top : slots[k].top);
+  }
+  // Tops up the tree, finest first (cell ids grow with the level): every ancestor holds the
+  // highest content of its subtree; the top levels in top_content.
+  top_content.resize(static_cast<std::size_t>(top));
+  for (int l = -top; l < 0; ++l) {
+    top_content[static_cast<std::size_t>(l + top)].assign(static_cast<std::size_t>(cells_at(l)) * static_cast<std::size_t>(cells_at(l)),
+                                                         -std::numeric_limits<float>::infinity());
+  }
+  for (std::size_t k = cells.size(); k-- > 0;) {
+    const CellName c = cell_name(*this, cells[k]);
+    const float t = content[k].top;
+    if (c.level > 0) {
+      CellContent& parent = content[static_cast<std::size_t>(content_index.find(cell_id(c.level - 1, c.ci / 2, c.cj / 2)))];
+      parent.top = std::max(parent.top, t);
+    } else if (top > 0) {
+      float& p = top_content[static_cast<std::size_t>(top - 1)][static_cast<std::size_t>((c.cj / 2) * cells_at(-1) + c.ci / 2)];
+      p = std::max(p, t);
     }
   }
+  for (int l = -1; l > -top; --l) {
+    const int c = cells_at(l);
+    for (int cj = 0; cj < c; ++cj)
+      for (int ci = 0; ci < c; ++ci) {
+        const float t = top_content[static_cast<std::size_t>(l + top)][static_cast<std::size_t>(cj * c + ci)];
+        float& p = top_content[static_cast<std::size_t>(l - 1 + top)][static_cast<std::size_t>((cj / 2) * cells_at(l - 1) + ci / 2)];
+        p = std::max(p, t);
+      }
+  }
+}
+
+void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std::vector<SlotKey> touched) {
+  const auto t0 = Clock::now();
+  std::vector<std::uint32_t> changed = changed_in;
+  std::sort(changed.begin(), changed.end());
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+
+  // Each touched slot, in parallel: its old store less the changed surfaces' polygons, with
+  // their new pieces inserted; built anew from every surface's pieces when it was empty or
+  // would be worn (far more planes than polygons); a low slot never drawn stays unbuilt.
+  std::vector<Slot> fresh(touched.size());
+  std::vector<std::size_t> removed(touched.size(), 0);
+  tbb::parallel_for(std::size_t{0}, touched.size(), [&](std::size_t k) {
+    const SlotKey key = touched[k];
+    Slot& slot = fresh[k];
+    const auto old = std::lower_bound(slots.begin(), slots.end(), key, [](const Slot& a, SlotKey b) { return a.key < b; });
+    if (old != slots.end() && old->key == key) slot = std::move(*old);
+    slot.key = key;
+    slot.pending = 0;
+    slot.top = -1e30f;
+    for (const auto& [id, s] : surfaces) {
+      for (auto [it, end] = arrivals(s, key); it != end; ++it) {
+        ++slot.pending;
+        for (std::uint32_t r = 0; r < it->count; ++r) slot.top = std::max(slot.top, static_cast<float>(s.vertices[s.refs[it->first + r]].z));
+      }
+    }
+    if (slot.pending == 0) {  // nothing left here
+      if (slot.built) removed[k] = slot.store.refs.size();
+      slot = Slot{};
+      slot.key = key;
+      return;
+    }
+    if (is_low(key) && !slot.built) return;  // built when first drawn
+    bool anew = !slot.built;
+    if (slot.built) {
+      removed[k] = remove_surfaces(slot.store, changed, positions);
+      anew = slot.store.pieces == 0 || slot.store.nodes.size() > 4 * slot.store.pieces + 64;
+      if (anew) removed[k] += slot.store.refs.size();
+    }
+    if (anew) slot.store = BspStore{};
+    SlotBuilder builder(*this, slot.store);
+    for (const auto& [id, s] : surfaces) {
+      if (!anew && !std::binary_search(changed.begin(), changed.end(), id)) continue;
+      for (auto [it, end] = arrivals(s, key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+    }
+    if (is_low(key)) {
+      const CellName c = cell_name(*this, key / 2);
+      builder.build_low(c.level, c.ci, c.cj);
+    } else {
+      builder.build_autopartition();
+    }
+    slot.built = true;
+    slot.pending = 0;
+  });
+  // Merge into the sorted slots: untouched ones kept, touched ones replaced (or gone when empty).
+  std::vector<Slot> merged;
+  merged.reserve(slots.size() + fresh.size());
+  std::size_t a = 0, b = 0;
+  while (a < slots.size() || b < fresh.size()) {
+    if (b == fresh.size() || (a < slots.size() && slots[a].key < fresh[b].key)) {
+      merged.push_back(std::move(slots[a++]));
+    } else {
+      if (a < slots.size() && slots[a].key == fresh[b].key) ++a;
+      if (fresh[b].pending > 0 || fresh[b].built) merged.push_back(std::move(fresh[b]));
+      ++b;
+    }
+  }
+  slots = std::move(merged);
+  slots.shrink_to_fit();
+  if (surfaces.empty()) release(surfaces);
+  merge_stats.rebuilt_slots += touched.size();
+  for (std::size_t r : removed) dead_refs += r;
+  std::size_t staged = 0;
+  for (const Slot& slot : slots) staged += slot.store.positions.size();
+  positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
+  merged_colors.reserve(merged_colors.size() + staged);
+  for (Slot& slot : slots) {
+    if (!slot.store.positions.empty() || slot.store.staged_refs < slot.store.refs.size()) flush(slot.store);
+  }
+  std::size_t live = 0;
+  for (const Slot& slot : slots) live += slot.store.refs.size();
+  if (dead_refs > live) compact();
+  make_content();
+
   merge_stats.surfaces = surfaces.size();
   merge_stats.input_triangles = 0;
-  merge_stats.dropped_pieces = dropped;
+  merge_stats.dropped_pieces = 0;
+  merge_stats.stored_polygons = 0;
+  merge_stats.pending_slots = 0;
+  merge_stats.pending_pieces = 0;
   for (const auto& [id, s] : surfaces) {
     merge_stats.input_triangles += s.input_triangles;
     merge_stats.dropped_pieces += s.dropped;
   }
-  merge_stats.stored_polygons = pieces;
-  merge_stats.slots = slots.size();
-  merge_stats.pending_slots = 0;
-  merge_stats.pending_pieces = 0;
   for (const Slot& slot : slots) {
+    merge_stats.stored_polygons += slot.store.pieces;
+    merge_stats.dropped_pieces += slot.store.dropped;
     merge_stats.pending_slots += slot.built ? 0 : 1;
     merge_stats.pending_pieces += slot.pending;
   }
+  merge_stats.slots = slots.size();
   merge_stats.merged_vertices = merged_colors.size();
   merge_stats.build_ms += ms_since(t0);
 }
 
-}  // namespace terravol::mrbsp
-
-namespace terravol::mrbsp {
+void TerrainTree::Impl::build_pending(std::size_t k) {
+  Slot& slot = slots[k];
+  const auto t0 = Clock::now();
+  SlotBuilder builder(*this, slot.store);
+  for (const auto& [id, s] : surfaces) {
+    for (auto [it, end] = arrivals(s, slot.key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+  }
+  const CellName c = cell_name(*this, slot.key / 2);
+  builder.build_low(c.level, c.ci, c.cj);
+  slot.built = true;
+  slot.pending = 0;
+  flush(slot.store);
+  merge_stats.stored_polygons += slot.store.pieces;
+  merge_stats.dropped_pieces += slot.store.dropped;
+  merge_stats.merged_vertices = merged_colors.size();
+  --merge_stats.pending_slots;
+  ++merge_stats.lazy_built_slots;
+  merge_stats.lazy_build_ms += ms_since(t0);
+}
 
 namespace {
 
@@ -879,10 +1053,19 @@ void TerrainTree::Impl::redistribute_all() {
   merge_stats.lazy_build_ms = 0.0;
   tbb::parallel_for(std::size_t{0}, surfaces.size(), [&](std::size_t k) { distribute(surfaces[k].second); });
   merge_stats.distribute_ms = ms_since(t0);
-  std::vector<SlotKey> dirty;
-  for (const auto& [id, s] : surfaces) keys_of(s, dirty);
+  std::vector<SlotKey> touched;
+  std::vector<std::uint32_t> ids;
+  for (const auto& [id, s] : surfaces) {
+    keys_of(s, touched);
+    ids.push_back(id);
+  }
   release(slots);
-  rebuild(dirty);
+  positions.resize(merged_base());
+  positions.shrink_to_fit();
+  release(merged_colors);
+  dead_refs = 0;
+  ++merged_version;
+  update(ids, touched);
   merge_stats.merge_ms = ms_since(t0);
 }
 
@@ -895,13 +1078,26 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   m.merge_stats.build_ms = 0.0;
   m.merge_stats.lazy_built_slots = 0;
   m.merge_stats.lazy_build_ms = 0.0;
-  std::vector<SlotKey> dirty;
-  std::vector<std::size_t> changed;  // indices into m.surfaces to distribute
+  // Replacing every surface there is: start from nothing (no old polygons to remove).
+  bool everything = true;
+  for (const auto& [id, s] : m.surfaces) everything = everything && std::find(ids.begin(), ids.end(), id) != ids.end();
+  if (everything) {
+    release(m.slots);
+    m.positions.resize(m.merged_base());
+    m.positions.shrink_to_fit();
+    release(m.merged_colors);
+    m.dead_refs = 0;
+    ++m.merged_version;
+  }
+  std::vector<SlotKey> touched;
+  const auto find = [&](std::uint32_t id) {
+    return std::lower_bound(m.surfaces.begin(), m.surfaces.end(), id,
+                            [](const std::pair<std::uint32_t, SurfacePieces>& a, std::uint32_t i) { return a.first < i; });
+  };
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    auto it = std::lower_bound(m.surfaces.begin(), m.surfaces.end(), ids[k],
-                               [](const std::pair<std::uint32_t, SurfacePieces>& a, std::uint32_t id) { return a.first < id; });
+    auto it = find(ids[k]);
     if (it != m.surfaces.end() && it->first == ids[k]) {
-      keys_of(it->second, dirty);
+      if (!everything) keys_of(it->second, touched);
       m.surfaces.erase(it);
     }
     const SurfaceInput& in = inputs[k];
@@ -912,17 +1108,16 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
     s.triangles.assign(in.triangles.begin(), in.triangles.end());
     s.vertices.assign(in.vertices.begin(), in.vertices.end());
     s.colors.assign(in.colors.begin(), in.colors.end());
-    it = std::lower_bound(m.surfaces.begin(), m.surfaces.end(), ids[k],
-                          [](const std::pair<std::uint32_t, SurfacePieces>& a, std::uint32_t id) { return a.first < id; });
-    m.surfaces.insert(it, {ids[k], std::move(s)});
+    m.surfaces.insert(find(ids[k]), {ids[k], std::move(s)});
   }
+  std::vector<std::size_t> changed;  // indices into m.surfaces to distribute
   for (std::size_t k = 0; k < m.surfaces.size(); ++k) {
     if (std::find(ids.begin(), ids.end(), m.surfaces[k].first) != ids.end()) changed.push_back(k);
   }
   tbb::parallel_for(std::size_t{0}, changed.size(), [&](std::size_t k) { m.distribute(m.surfaces[changed[k]].second); });
   m.merge_stats.distribute_ms = ms_since(t0);
-  for (std::size_t k : changed) keys_of(m.surfaces[k].second, dirty);
-  m.rebuild(dirty);
+  for (std::size_t k : changed) keys_of(m.surfaces[k].second, touched);
+  m.update(std::vector<std::uint32_t>(ids.begin(), ids.end()), std::move(touched));
   m.merge_stats.merge_ms = ms_since(t0);
   return m.merge_stats;
 }
@@ -947,53 +1142,9 @@ MergeStats TerrainTree::merge(std::span<const glm::dvec3> vertices, std::span<co
   return set_surfaces(ids, inputs);
 }
 
-bool TerrainTree::Impl::build_store(Slot& slot) const {
-  BspStore store;
-  SlotBuilder builder(*this, store);
-  std::size_t pieces = 0;
-  for (std::uint32_t si = 0; si < surfaces.size(); ++si) {
-    const SurfacePieces& s = surfaces[si].second;
-    const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{slot.key, 0, 0},
-                                        [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
-    for (auto it = range.first; it != range.second; ++it) {
-      builder.add(s, si, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
-      ++pieces;
-    }
-  }
-  if (pieces == 0) return false;
-  if (slot.key >= kOutsideKey0 || slot.key % 2 == static_cast<SlotKey>(SlotKind::kAbove)) {
-    builder.build_autopartition();
-  } else {
-    const CellName c = cell_name(*this, static_cast<std::uint32_t>(slot.key / 2));
-    builder.build_low(c.level, c.ci, c.cj);
-  }
-  store.dropped = builder.dropped();
-  slot.store = std::move(store);
-  slot.built = true;
-  slot.pending = 0;
-  return true;
-}
-
-void TerrainTree::Impl::build_pending(std::size_t k) {
-  Slot& slot = slots[k];
-  const auto t0 = Clock::now();
-  build_store(slot);
-  BspStore& st = slot.store;
-  st.base = static_cast<std::uint32_t>(positions.size());
-  positions.insert(positions.end(), st.positions.begin(), st.positions.end());
-  merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
-  release(st.positions);
-  release(st.colors);
-  merge_stats.stored_polygons += slot.store.pieces;
-  merge_stats.dropped_pieces += slot.store.dropped;
-  merge_stats.merged_vertices = merged_colors.size();
-  --merge_stats.pending_slots;
-  ++merge_stats.lazy_built_slots;
-  merge_stats.lazy_build_ms += ms_since(t0);
-}
-
 const MergeStats& TerrainTree::merge_stats() const { return impl_->merge_stats; }
 const std::vector<glm::u8vec4>& TerrainTree::merged_colors() const { return impl_->merged_colors; }
 std::uint32_t TerrainTree::merged_base() const { return impl_->merged_base(); }
+std::uint64_t TerrainTree::merged_version() const { return impl_->merged_version; }
 
 }  // namespace terravol::mrbsp

@@ -499,7 +499,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   };
   // A slot's small BSP: the far side of each plane first.
   auto emit_store = [&](const BspStore& store) {
-    const auto ref = [&](std::uint32_t v) { return (v & kTerrainRef) ? (v & ~kTerrainRef) : store.base + v; };
+    const auto ref = [](std::uint32_t v) { return v; };
     auto& st = frame.leaf_stack_;
     st.clear();
     if (store.root >= 0) st.push_back(store.root);

@@ -186,6 +186,11 @@ class TerrainTree {
   // RGBA of merged vertex k, which is positions()[merged_base() + k].
   const std::vector<glm::u8vec4>& merged_colors() const;
   std::uint32_t merged_base() const;
+  // Changes whenever merged vertices already in positions() are renumbered or replaced (a
+  // merge of everything, a slide, a compaction after edits). While it stays the same, merges
+  // and traversals only append vertices, so a renderer holding positions() need only take the
+  // new tail.
+  std::uint64_t merged_version() const;
 
   // The bytes held now, by part (MemoryStats). nodes and vertices depend only on cells() and
   // levels(): about 170 bytes per lattice sample for 3 or more levels (2.3 nodes of 56 bytes

@@ -29,42 +29,48 @@ struct CellZ {
   float zmin = 0.0f, zmax = 0.0f, error = 0.0f;
 };
 
-// A convex planar polygon of a small BSP: `count` vertex references from BspStore::refs[first].
-// A reference with kTerrainRef set is a lattice vertex (the rest of the bits), otherwise an
-// index into the store's vertices (its slot's base is added when drawn).
+// A convex planar polygon of a small BSP: `count` vertex indices (into TerrainTree::
+// positions()) from BspStore::refs[first], and the surface it comes from.
 struct Polygon {
   std::uint32_t first = 0;
   std::uint16_t count = 0;
   std::int8_t level = kMergedLevel;  // the terrain level for a cell's own triangles
+  std::uint32_t surface = 0;         // the surface id; kTerrainSurface for a terrain triangle
 };
+inline constexpr std::uint32_t kTerrainSurface = 0xFFFFFFFFu;
+// While a store is being built, a reference with kTerrainRef set is a lattice vertex (the rest
+// of the bits) and one without indexes the store's staged vertices.
 inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 
 // A node of a small BSP (section 4.2, "in a terrain leaf" and above the terrain): the plane
-// n.p + d = 0, the polygons lying in it, and the two sides (-1 when empty). The plane is kept
-// in single precision (the pieces were split against it in double): it only tells the eye's
-// side, wrong at most for an eye within millimetres of it, where either order draws the same.
+// n.p + d = 0, the polygons lying in it, and the two sides (-1 when empty; kDropSide for the
+// space below a low alternative's terrain triangle, where pieces are dropped). The plane is
+// kept in single precision (the pieces were split against it in double): it only tells the
+// eye's side, wrong at most for an eye within millimetres of it, where either order draws the
+// same.
 struct BspNode {
   glm::vec3 n{0.0f};
   float d = 0.0f;
   std::int32_t back = -1, front = -1;
   std::uint32_t first = 0, count = 0;  // into the store's polys
 };
+inline constexpr std::int32_t kDropSide = -2;
 
-// The small BSPs of one slot: nodes, polygons and references. Its vertices (float, as drawn,
-// with their RGBA) are made in `positions` and `colors`, then moved into the tree's merged
-// vertices, where they are vertices [base, base + vertex_count).
+// The small BSP of one slot: nodes, polygons and references (indices into positions()). New
+// vertices are staged in `positions` and `colors`, with the references made since
+// `staged_refs` pointing into them, until Impl::flush() moves them into the tree's merged
+// vertices and makes those references global.
 struct BspStore {
   std::vector<BspNode> nodes;
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
-  std::vector<glm::vec3> positions;  // empty once moved into the tree
+  std::vector<glm::vec3> positions;  // staged, empty once flushed
   std::vector<glm::u8vec4> colors;
+  std::uint32_t staged_refs = 0;
   std::int32_t root = -1;
-  std::uint32_t base = 0;       // where its vertices start in TerrainTree::positions()
-  std::uint32_t vertex_count = 0;
-  std::size_t pieces = 0;       // merged polygons (terrain triangles not counted)
-  std::size_t dropped = 0;      // pieces found below the low triangles and dropped
-  float top = -1e30f;           // highest merged vertex
+  std::size_t pieces = 0;   // merged polygons (terrain triangles not counted)
+  std::size_t dropped = 0;  // pieces found below the low triangles and dropped
+  float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
 };
 
@@ -156,6 +162,8 @@ struct TerrainTree::Impl {
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
   std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
   std::vector<glm::u8vec4> merged_colors;
+  std::size_t dead_refs = 0;  // references removed since the merged vertices were last compacted
+  std::uint64_t merged_version = 0;  // changes whenever merged vertices are renumbered
   MergeStats merge_stats;
 
   int cells_at(int level) const { return n >> (levels - 1 - level); }  // per side, any level >= -top
@@ -175,12 +183,18 @@ struct TerrainTree::Impl {
   // rebuild() makes the slots whose keys are in `dirty` again from every surface's pieces,
   // then the cell content and the merged vertices.
   void distribute(SurfacePieces& s) const;
-  void rebuild(const std::vector<SlotKey>& dirty);
-  // Builds slots[k] (a low slot first drawn) and appends its vertices to positions.
+  // After the surfaces with ids `changed` were replaced (their pieces distributed anew) and
+  // `touched` holds every slot key their old or new pieces reach: removes their old polygons
+  // from those slots and inserts the new ones (a slot left empty or worn is built anew from
+  // every surface's pieces), then flushes the vertices and remakes the cell content.
+  void update(const std::vector<std::uint32_t>& changed, std::vector<SlotKey> touched);
+  void redistribute_all();  // after refresh(): every surface again, every slot anew
+  // Builds slots[k] (a low slot first drawn) and flushes its vertices.
   void build_pending(std::size_t k);
-  // Builds a slot's store from every surface's pieces there; false when none arrived.
-  bool build_store(Slot& slot) const;
-  void redistribute_all();  // after refresh(): every surface again, every slot
+  // Moves a store's staged vertices into positions and merged_colors.
+  void flush(BspStore& store);
+  void make_content();
+  void compact();  // drops merged vertices no reference uses
 };
 
 }  // namespace terravol::mrbsp
