@@ -134,6 +134,8 @@ void split_polygon(std::span<const std::uint32_t> in, double eps, Dist dist, Cut
   }
 }
 
+constexpr glm::vec2 kNoTcoord(-1.0f, -1.0f);
+
 glm::u8vec4 mix_color(glm::u8vec4 a, glm::u8vec4 b, double t) {
   return glm::u8vec4(glm::round(glm::mix(glm::dvec4(a), glm::dvec4(b), t)));
 }
@@ -152,6 +154,7 @@ class Distributor {
     s_.refs.clear();
     s_.vertices.resize(s_.input_vertices);
     s_.colors.resize(s_.input_vertices);
+    if (!s_.tcoords.empty()) s_.tcoords.resize(s_.input_vertices);
     s_.dropped = 0;
     for (std::size_t t = 0; t + 2 < s_.triangles.size(); t += 3) {
       pool_.clear();
@@ -168,6 +171,7 @@ class Distributor {
                      [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
     s_.vertices.shrink_to_fit();
     s_.colors.shrink_to_fit();
+    s_.tcoords.shrink_to_fit();
     s_.pieces.shrink_to_fit();
     s_.refs.shrink_to_fit();
   }
@@ -243,6 +247,7 @@ class Distributor {
             p[axis] = offset;  // exactly in the plane
             s_.vertices.push_back(p);
             s_.colors.push_back(mix_color(s_.colors[a], s_.colors[b], t));
+            if (!s_.tcoords.empty()) s_.tcoords.push_back(glm::mix(s_.tcoords[a], s_.tcoords[b], static_cast<float>(t)));
             return static_cast<std::uint32_t>(s_.vertices.size() - 1);
           });
         },
@@ -368,6 +373,7 @@ class SlotBuilder {
       if (fresh) {
         pos_.push_back(surface.vertices[v]);
         col_.push_back(surface.colors[v]);
+        tc_.push_back(surface.tcoords.empty() ? kNoTcoord : surface.tcoords[v]);
       }
       ids_.push_back(it->second);
     }
@@ -458,6 +464,7 @@ class SlotBuilder {
     return (v & kTerrainRef) ? glm::dvec3(m_.positions[v & ~kTerrainRef]) : pos_[v];
   }
   glm::u8vec4 color(std::uint32_t v) const { return (v & kTerrainRef) ? glm::u8vec4(255) : col_[v]; }
+  glm::vec2 tcoord(std::uint32_t v) const { return (v & kTerrainRef) ? kNoTcoord : tc_[v]; }
 
   std::int32_t new_node(const PlaneD& p) {
     BspNode node;
@@ -525,6 +532,7 @@ class SlotBuilder {
                 return cache_.get(a, b, static_cast<std::uint32_t>(node), [&] {
                   pos_.push_back(glm::mix(pos(a), pos(b), t));
                   col_.push_back(mix_color(color(a), color(b), t));
+                  tc_.push_back(glm::mix(tcoord(a), tcoord(b), static_cast<float>(t)));
                   return static_cast<std::uint32_t>(pos_.size() - 1);
                 });
               },
@@ -693,6 +701,7 @@ class SlotBuilder {
               remap[v] = static_cast<std::uint32_t>(out_.positions.size());
               out_.positions.emplace_back(pos_[v]);
               out_.colors.push_back(col_[v]);
+              if (m_.has_tcoords) out_.tcoords.push_back(tc_[v]);
               out_.top = std::max(out_.top, static_cast<float>(pos_[v].z));
             }
             v = remap[v];
@@ -717,6 +726,7 @@ class SlotBuilder {
   std::unordered_map<std::uint64_t, std::uint32_t> local_;  // (surface, vertex) -> local vertex
   std::vector<glm::dvec3> pos_;
   std::vector<glm::u8vec4> col_;
+  std::vector<glm::vec2> tc_;
   std::vector<Poly> polys_;
   std::vector<std::uint32_t> ids_, list_, back_list_, front_list_, split_a_, split_b_, tmp_;
   std::vector<std::pair<std::int32_t, std::uint32_t>> coplanar_;  // (node, polygon)
@@ -807,9 +817,11 @@ void TerrainTree::Impl::flush(BspStore& st) {
     const std::size_t want = std::max(positions.size() + st.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
     positions.reserve(want);
     merged_colors.reserve(want - merged_base());
+    if (has_tcoords) merged_tcoords.reserve(want - merged_base());
   }
   positions.insert(positions.end(), st.positions.begin(), st.positions.end());
   merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
+  merged_tcoords.insert(merged_tcoords.end(), st.tcoords.begin(), st.tcoords.end());
   for (std::size_t r = st.staged_refs; r < st.refs.size(); ++r) {
     const std::uint32_t v = st.refs[r];
     st.refs[r] = (v & kTerrainRef) ? (v & ~kTerrainRef) : base + v;
@@ -817,6 +829,7 @@ void TerrainTree::Impl::flush(BspStore& st) {
   st.staged_refs = static_cast<std::uint32_t>(st.refs.size());
   release(st.positions);
   release(st.colors);
+  release(st.tcoords);
 }
 
 void TerrainTree::Impl::compact() {
@@ -824,6 +837,7 @@ void TerrainTree::Impl::compact() {
   std::vector<std::uint32_t> remap(positions.size() - base, std::numeric_limits<std::uint32_t>::max());
   std::vector<glm::vec3> kept_positions(positions.begin(), positions.begin() + base);
   std::vector<glm::u8vec4> kept_colors;
+  std::vector<glm::vec2> kept_tcoords;
   for (Slot& slot : slots) {
     for (std::uint32_t& v : slot.store.refs) {
       if (v < base) continue;
@@ -832,6 +846,7 @@ void TerrainTree::Impl::compact() {
         r = static_cast<std::uint32_t>(kept_positions.size());
         kept_positions.push_back(positions[v]);
         kept_colors.push_back(merged_colors[v - base]);
+        if (has_tcoords) kept_tcoords.push_back(merged_tcoords[v - base]);
       }
       v = r;
     }
@@ -840,6 +855,7 @@ void TerrainTree::Impl::compact() {
   kept_colors.shrink_to_fit();
   positions = std::move(kept_positions);
   merged_colors = std::move(kept_colors);
+  merged_tcoords = std::move(kept_tcoords);
   dead_refs = 0;
   ++merged_version;
 }
@@ -976,6 +992,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   for (const Slot& slot : slots) staged += slot.store.positions.size();
   positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
   merged_colors.reserve(merged_colors.size() + staged);
+  if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
   for (Slot& slot : slots) {
     if (!slot.store.positions.empty() || slot.store.staged_refs < slot.store.refs.size()) flush(slot.store);
   }
@@ -1032,6 +1049,10 @@ void check_surface(const SurfaceInput& s) {
     throw std::invalid_argument("TerrainTree::merge: " + std::to_string(s.colors.size()) + " colours for " +
                                 std::to_string(s.vertices.size()) + " vertices");
   }
+  if (!s.tcoords.empty() && s.tcoords.size() != s.vertices.size()) {
+    throw std::invalid_argument("TerrainTree::merge: " + std::to_string(s.tcoords.size()) + " texture coordinates for " +
+                                std::to_string(s.vertices.size()) + " vertices");
+  }
   if (s.triangles.size() % 3 != 0) throw std::invalid_argument("TerrainTree::merge: triangle indices not a multiple of 3");
   for (std::uint32_t i : s.triangles) {
     if (i >= s.vertices.size()) throw std::invalid_argument("TerrainTree::merge: index " + std::to_string(i) + " out of range");
@@ -1063,6 +1084,7 @@ void TerrainTree::Impl::redistribute_all() {
   positions.resize(merged_base());
   positions.shrink_to_fit();
   release(merged_colors);
+  release(merged_tcoords);
   dead_refs = 0;
   ++merged_version;
   update(ids, touched);
@@ -1078,14 +1100,24 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   m.merge_stats.build_ms = 0.0;
   m.merge_stats.lazy_built_slots = 0;
   m.merge_stats.lazy_build_ms = 0.0;
-  // Replacing every surface there is: start from nothing (no old polygons to remove).
-  bool everything = true;
-  for (const auto& [id, s] : m.surfaces) everything = everything && std::find(ids.begin(), ids.end(), id) != ids.end();
+  // Replacing every surface there is, or the first with texture coordinates coming or the last
+  // going: start from nothing (no old polygons to remove).
+  bool everything = true, tcoords = false;
+  for (const auto& [id, s] : m.surfaces) {
+    const bool replaced = std::find(ids.begin(), ids.end(), id) != ids.end();
+    everything = everything && replaced;
+    tcoords = tcoords || (!replaced && !s.tcoords.empty());
+  }
+  for (const SurfaceInput& in : inputs) tcoords = tcoords || (!in.tcoords.empty() && !in.triangles.empty());
+  const bool flip = tcoords != m.has_tcoords;  // then every surface is merged again
+  m.has_tcoords = tcoords;
+  everything = everything || flip;
   if (everything) {
     release(m.slots);
     m.positions.resize(m.merged_base());
     m.positions.shrink_to_fit();
     release(m.merged_colors);
+    release(m.merged_tcoords);
     m.dead_refs = 0;
     ++m.merged_version;
   }
@@ -1108,16 +1140,19 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
     s.triangles.assign(in.triangles.begin(), in.triangles.end());
     s.vertices.assign(in.vertices.begin(), in.vertices.end());
     s.colors.assign(in.colors.begin(), in.colors.end());
+    s.tcoords.assign(in.tcoords.begin(), in.tcoords.end());
     m.surfaces.insert(find(ids[k]), {ids[k], std::move(s)});
   }
   std::vector<std::size_t> changed;  // indices into m.surfaces to distribute
+  std::vector<std::uint32_t> changed_ids(ids.begin(), ids.end());
   for (std::size_t k = 0; k < m.surfaces.size(); ++k) {
-    if (std::find(ids.begin(), ids.end(), m.surfaces[k].first) != ids.end()) changed.push_back(k);
+    if (flip || std::find(ids.begin(), ids.end(), m.surfaces[k].first) != ids.end()) changed.push_back(k);
+    if (flip) changed_ids.push_back(m.surfaces[k].first);
   }
   tbb::parallel_for(std::size_t{0}, changed.size(), [&](std::size_t k) { m.distribute(m.surfaces[changed[k]].second); });
   m.merge_stats.distribute_ms = ms_since(t0);
   for (std::size_t k : changed) keys_of(m.surfaces[k].second, touched);
-  m.update(std::vector<std::uint32_t>(ids.begin(), ids.end()), std::move(touched));
+  m.update(changed_ids, std::move(touched));
   m.merge_stats.merge_ms = ms_since(t0);
   return m.merge_stats;
 }
@@ -1144,6 +1179,7 @@ MergeStats TerrainTree::merge(std::span<const glm::dvec3> vertices, std::span<co
 
 const MergeStats& TerrainTree::merge_stats() const { return impl_->merge_stats; }
 const std::vector<glm::u8vec4>& TerrainTree::merged_colors() const { return impl_->merged_colors; }
+const std::vector<glm::vec2>& TerrainTree::merged_tcoords() const { return impl_->merged_tcoords; }
 std::uint32_t TerrainTree::merged_base() const { return impl_->merged_base(); }
 std::uint64_t TerrainTree::merged_version() const { return impl_->merged_version; }
 

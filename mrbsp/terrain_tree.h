@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -79,11 +80,13 @@ struct MergeStats {
 };
 
 // A surface to merge: three indices per triangle into `vertices` (scene frame, metres), with
-// per-vertex RGBA `colors` (translucent or opaque).
+// per-vertex RGBA `colors` (translucent or opaque) and, optionally, per-vertex texture
+// coordinates (empty, or one per vertex), interpolated like the colours where pieces are split.
 struct SurfaceInput {
   std::span<const glm::dvec3> vertices;
   std::span<const glm::u8vec4> colors;
   std::span<const std::uint32_t> triangles;
+  std::span<const glm::vec2> tcoords = {};
 };
 
 // Bytes a TerrainTree holds, by part: the capacities of its containers times their element
@@ -185,6 +188,9 @@ class TerrainTree {
   const MergeStats& merge_stats() const;
   // RGBA of merged vertex k, which is positions()[merged_base() + k].
   const std::vector<glm::u8vec4>& merged_colors() const;
+  // Texture coordinates of merged vertex k when some surface has them (then one per merged
+  // vertex, (-1, -1) for vertices of surfaces without), else empty.
+  const std::vector<glm::vec2>& merged_tcoords() const;
   std::uint32_t merged_base() const;
   // Changes whenever merged vertices already in positions() are renumbered or replaced (a
   // merge of everything, a slide, a compaction after edits). While it stays the same, merges

@@ -66,6 +66,7 @@ struct BspStore {
   std::vector<std::uint32_t> refs;
   std::vector<glm::vec3> positions;  // staged, empty once flushed
   std::vector<glm::u8vec4> colors;
+  std::vector<glm::vec2> tcoords;
   std::uint32_t staged_refs = 0;
   std::int32_t root = -1;
   std::size_t pieces = 0;   // merged polygons (terrain triangles not counted)
@@ -117,6 +118,7 @@ struct SurfacePieces {
   std::vector<std::uint32_t> triangles;      // the input triangles (kept for slide())
   std::vector<glm::dvec3> vertices;
   std::vector<glm::u8vec4> colors;
+  std::vector<glm::vec2> tcoords;  // empty, or one per vertex
   struct Piece {
     SlotKey slot;
     std::uint32_t first;  // into refs
@@ -162,6 +164,8 @@ struct TerrainTree::Impl {
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
   std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
   std::vector<glm::u8vec4> merged_colors;
+  std::vector<glm::vec2> merged_tcoords;  // one per merged vertex while has_tcoords, else empty
+  bool has_tcoords = false;               // some surface has texture coordinates
   std::size_t dead_refs = 0;  // references removed since the merged vertices were last compacted
   std::uint64_t merged_version = 0;  // changes whenever merged vertices are renumbered
   MergeStats merge_stats;

@@ -265,6 +265,55 @@ TEST(Merge, EditsKeepTheOrderAndDrawEachVisiblePartOnce) {
   check(joined({&b, &c, &d}), "after adding 7 and replacing 4");
 }
 
+// Texture coordinates ride along with the colours: on a sheet whose coordinates are a linear
+// function of position, every merged vertex (input or made by a split) keeps that function's
+// value; vertices of a surface without coordinates get (-1, -1).
+TEST(Merge, TextureCoordinatesAreInterpolatedWhereverPiecesAreSplit) {
+  std::mt19937 rng(21);
+  TestWindow w(16, [](int, int) { return 0.0f; });
+  TerrainTree tree = hilly_tree(rng, w);
+  test::TriangleSoup sheet;
+  std::vector<glm::vec2> tc;
+  std::uniform_real_distribution<double> z(100.0, 450.0);
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) {
+      sheet.v.emplace_back(-50.0 + 420.0 * i, -50.0 + 420.0 * j, z(rng));
+      sheet.c.emplace_back(20, 40, 200, 150);
+      tc.emplace_back(static_cast<float>(sheet.v.back().x / 1000.0), static_cast<float>(sheet.v.back().y / 1000.0));
+    }
+  for (std::uint32_t j = 0; j < 4; ++j)
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t a = j * 5 + i;
+      sheet.t.insert(sheet.t.end(), {a, a + 1, a + 6, a, a + 6, a + 5});
+    }
+  const Soup plain = random_soup(rng, 10, false);
+  const std::uint32_t ids[2] = {1, 2};
+  const SurfaceInput inputs[2] = {{sheet.v, sheet.c, sheet.t, tc}, {plain.v, plain.c, plain.t}};
+  tree.set_surfaces(ids, inputs);
+  Frame f;
+  TraversalOptions o;
+  o.cull = false;
+  o.full_res = true;
+  tree.traverse(camera_at({-300, -300, 900}, {1, 1, -0.5}), o, f);
+  const auto& p = tree.positions();
+  const auto& t = tree.merged_tcoords();
+  ASSERT_EQ(t.size(), p.size() - tree.merged_base());
+  std::size_t textured = 0, plain_vertices = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] == glm::vec2(-1.0f, -1.0f)) {  // the sheet's coordinates stay above -0.05
+      ++plain_vertices;
+      continue;
+    }
+    ++textured;
+    EXPECT_NEAR(t[k].x, p[tree.merged_base() + k].x / 1000.0, 1e-4) << "vertex " << k;
+    EXPECT_NEAR(t[k].y, p[tree.merged_base() + k].y / 1000.0, 1e-4) << "vertex " << k;
+  }
+  EXPECT_GT(textured, sheet.v.size()) << "the sheet is split";
+  EXPECT_GT(plain_vertices, 0u);
+  tree.set_surface(1, SurfaceInput{});
+  EXPECT_TRUE(tree.merged_tcoords().empty()) << "no surface has coordinates any more";
+}
+
 TEST(Merge, RejectsIndicesOutOfRangeAndMismatchedColours) {
   TestWindow w(4, [](int, int) { return 0.0f; });
   TerrainTree tree(w.view(), 2);
