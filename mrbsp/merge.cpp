@@ -4,7 +4,7 @@
 // cell) put a copy into every alternative: the cell's low representation and its high subtree.
 //
 // Departures from the paper, and why (measured on the benchmark scenes, docs/architecture.md):
-//   - A cell's terrain, in all its alternatives and with its skirts' tops, lies within the z
+//   - A cell's terrain, in all its alternatives and with its crack fills, lies within the z
 //     range [zmin, zmax] of its full-resolution samples. The plane z = zmax is therefore a
 //     legal splitter of the cell's region: a piece above it stays at the cell, whole, in a
 //     small BSP of its own ("above" slot), ordered against the whole terrain subtree by the

@@ -18,16 +18,16 @@
 //     size. Per cell the tree keeps only its z range and error (CellZ); the traversal is an
 //     explicit stack of implicit node names (no recursion, no pointers).
 //   - The paper leaves cracks between neighbours at different levels unaddressed; there is no
-//     depth buffer to hide them here, so they are filled with skirts: vertical quads in the
-//     shared boundary plane, emitted only where the neighbour cell at the same level was not
-//     drawn this frame (its region is drawn coarser or finer). A skirt lies in a split plane,
-//     so it is ordered exactly: before the cell's triangles when the plane faces away from the
-//     eye, after them otherwise. Skirts hang to a bottom below every level's polyline along
-//     their lattice line within the level-0 cell edge (each such polyline interpolates samples
-//     of that edge), so the two sides' skirts together cover the gap, whichever side is
-//     higher. With the eye above the ground only the skirts facing the eye can show a crack
-//     (a ray reaching a gap under the near cell's edge has crossed the near cell's surface),
-//     so only those are drawn; below the ground only the others; near it, both.
+//     depth buffer to hide them here. After the LOD choice, a balancing pass refines cells
+//     until drawn neighbours differ by at most one level (like a restricted quadtree; it
+//     depends on the camera only). Then the crack along the edge between a coarse cell and
+//     its finer neighbour is exactly the vertical triangle (corner, middle sample of the
+//     edge, corner): it lies in the shared boundary plane, is made of lattice samples and
+//     lies within both cells' z ranges, so culling by their boxes stays right and it is
+//     ordered like the plane: before the coarse cell's triangles when the plane faces away
+//     from the eye, after them otherwise. A crack next to a culled cell lies in that cell's
+//     box, outside the view, and needs no fill. (Earlier versions hung skirts 1 m below the
+//     lowest sample of the level-0 edge: about half of all terrain fragments.)
 //   - Inside a cell the two triangles are ordered by the vertical plane through the cell's
 //     diagonal, which separates them.
 //   - Merged polygons (merge.cpp) live in small BSPs at cells ("slots"); each region's culling
@@ -76,32 +76,7 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   ys.assign(w.ys.begin(), w.ys.end());
   const auto zw = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
-  // Skirt bottoms. Every level's polyline along a lattice line, inside one level-0 edge
-  // segment, interpolates samples of that segment; so a skirt under an edge on row j
-  // reaches low enough at the lowest sample of row j within the level-0 segment(s) holding
-  // the edge, minus 1 m. Two bottoms per sample: one for edges along its row (south and
-  // north skirts), one for edges along its column (west and east skirts).
-  const int s0 = cell_size(0), c0 = cells_at(0);
-  const std::size_t count = side * side;
-  positions.resize(3 * count);
-  std::vector<float> segment_min(static_cast<std::size_t>(c0));
-  for (int pass = 0; pass < 2; ++pass) {  // 0: along rows, 1: along columns
-    for (int line = 0; line <= n; ++line) {
-      const auto at = [&](int k) { return pass == 0 ? zw(k, line) : zw(line, k); };
-      for (int seg = 0; seg < c0; ++seg) {
-        float mn = at(seg * s0);
-        for (int k = seg * s0 + 1; k <= (seg + 1) * s0; ++k) mn = std::min(mn, at(k));
-        segment_min[static_cast<std::size_t>(seg)] = mn;
-      }
-      for (int k = 0; k <= n; ++k) {
-        float bottom = segment_min[static_cast<std::size_t>(std::min(k / s0, c0 - 1))];
-        if (k % s0 == 0 && k > 0) bottom = std::min(bottom, segment_min[static_cast<std::size_t>(k / s0 - 1)]);
-        const int i = pass == 0 ? k : line, j = pass == 0 ? line : k;
-        const std::size_t v = vertex(i, j);
-        positions[(1 + pass) * count + v] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), bottom - 1.0f);
-      }
-    }
-  }
+  positions.resize(side * side);
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), zw(i, j));
 
@@ -145,17 +120,6 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
             u.zmax = std::max(u.zmax, ch.zmax);
           }
         out[static_cast<std::size_t>(cj * c + ci)] = u;
-      }
-  }
-  // The largest error of any alternative inside each level-0 cell (for the skirt choice).
-  level0_error.assign(static_cast<std::size_t>(c0) * static_cast<std::size_t>(c0), 0.0f);
-  for (int level = 0; level + 1 < levels; ++level) {
-    const int c = cells_at(level), per = c / c0;
-    const std::vector<CellZ>& cz = cellz[static_cast<std::size_t>(level + top)];
-    for (int cj = 0; cj < c; ++cj)
-      for (int ci = 0; ci < c; ++ci) {
-        float& e0 = level0_error[static_cast<std::size_t>((cj / per) * c0 + ci / per)];
-        e0 = std::max(e0, cz[static_cast<std::size_t>(cj * c + ci)].error);
       }
   }
   redistribute_all();  // section 4.3: other objects are merged again into the moved tree
@@ -216,7 +180,7 @@ MemoryStats TerrainTree::memory() const {
   const Impl& m = *impl_;
   MemoryStats s;
   s.samples = m.lattice_count();
-  s.nodes = held(m.level_offset) + held(m.level0_error) + held(m.xs) + held(m.ys) + held(m.cellz);
+  s.nodes = held(m.level_offset) + held(m.xs) + held(m.ys) + held(m.cellz);
   for (const auto& level : m.cellz) s.nodes += held(level);
   // positions holds both: the terrain's blocks up to merged_base(), merged vertices after.
   const std::size_t terrain = std::min<std::size_t>(m.merged_base(), m.positions.capacity());
@@ -315,17 +279,22 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   frame.level.clear();
   frame.nodes_visited = 0;
   frame.leaves = 0;
-  frame.skirt_triangles = 0;
+  frame.crack_triangles = 0;
+  frame.balanced_cells = 0;
   frame.lod_histogram.assign(static_cast<std::size_t>(m.levels), 0);
+  // Per cell: the traversal's stamp << 2 | kDrawn or kRefined; anything else: not visited.
   if (frame.stamp_.size() != m.total_cells) {
     frame.stamp_.assign(m.total_cells, 0);
     frame.current_stamp_ = 0;
   }
-  if (++frame.current_stamp_ == 0) {  // wrapped: clear once every 2^32 frames
+  if (++frame.current_stamp_ >= (1u << 30)) {  // wrapped: clear once every 2^30 frames
     std::fill(frame.stamp_.begin(), frame.stamp_.end(), 0);
     frame.current_stamp_ = 1;
   }
-  const std::uint32_t stamp = frame.current_stamp_;
+  constexpr std::uint32_t kDrawn = 1, kRefined = 2;
+  const std::uint32_t stamp = frame.current_stamp_ << 2;
+  auto& marks = frame.stamp_;
+  const auto state = [&](std::uint32_t cell) { return (marks[cell] & ~3u) == stamp ? marks[cell] & 3u : 0u; };
 
   const glm::dvec3 f = glm::normalize(camera.forward);
   const glm::dvec3 r = glm::normalize(glm::cross(f, camera.up));
@@ -343,10 +312,110 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
     return c < 0 ? -std::numeric_limits<float>::infinity() : m.content[static_cast<std::size_t>(c)].top;
   };
+  const auto content_of = [&](int level, int ci, int cj) -> const CellContent* {
+    if (level < 0 || m.content_index.empty()) return nullptr;
+    const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
+    return c < 0 ? nullptr : &m.content[static_cast<std::size_t>(c)];
+  };
+  // The cell's terrain box, and whether the box holding its content too is in view.
+  struct Box {
+    glm::vec3 lo, hi;
+    float top;
+  };
+  const auto box_of = [&](int level, int ci, int cj, const CellZ& cz) {
+    const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
+    return Box{glm::vec3(static_cast<float>(m.xs[static_cast<std::size_t>(i0)]), static_cast<float>(m.ys[static_cast<std::size_t>(j0)]), cz.zmin),
+               glm::vec3(static_cast<float>(m.xs[static_cast<std::size_t>(i0 + s)]), static_cast<float>(m.ys[static_cast<std::size_t>(j0 + s)]), cz.zmax),
+               std::max(cz.zmax, content_top(level, ci, cj))};
+  };
+  const auto in_view = [&](const Box& b) { return !options.cull || !box_outside(planes, b.lo, glm::vec3(b.hi.x, b.hi.y, b.top)); };
 
-  // Pass 1: walk the tree, choose LODs, collect the drawn cells and slots in order. Items on
-  // the stack are pushed in reverse of the order they are to come out in.
+  // Pass 1, the LOD choice (sections 5 and 5.1): every cell in view, refined while the metric
+  // asks; the drawn cells listed by level.
   auto& stack = frame.stack_;
+  auto& by_level = frame.by_level_;
+  by_level.resize(static_cast<std::size_t>(m.levels));
+  for (auto& l : by_level) l.clear();
+  stack.clear();
+  stack.push_back(pack(kSquare, 0, 0, 0));
+  while (!stack.empty()) {
+    const std::uint64_t item = stack.back();
+    stack.pop_back();
+    const int level = level_index_of(item) - m.top, ci = ci_of(item), cj = cj_of(item);
+    ++frame.nodes_visited;
+    const CellZ cz = m.cell_z(level, ci, cj);
+    const Box box = box_of(level, ci, cj, cz);
+    if (!in_view(box)) continue;
+    bool refine = level < m.levels - 1;
+    if (level >= 0 && refine && !options.full_res) {
+      if (options.metric == LodMetric::kError) {
+        const double dist = std::max(box_distance(e, box.lo, box.hi), camera.near_plane);
+        refine = cz.error * focal_px / dist > options.threshold_px;
+      } else {
+        refine = box_area_px(camera, f, r, u, focal_px, box.lo, box.hi) > options.threshold_px;
+      }
+    }
+    if (level >= 0) marks[m.cell_id(level, ci, cj)] = stamp | (refine ? kRefined : kDrawn);
+    if (!refine) {
+      by_level[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) stack.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)));
+  }
+
+  // Pass 2, balance: neighbours drawn at most one level apart, so that every crack is one
+  // triangle of lattice samples (below). A drawn cell at level k needs every edge neighbour of
+  // its parent (level k - 1) refined or drawn; where one lies in a cell drawn at level k - 2 or
+  // coarser, that cell is refined (down to level k - 2) instead. Refining only creates drawn
+  // cells at coarser levels than k, so one sweep from the finest level up settles it. Depends
+  // on the camera only, never on what is visible beyond the frustum test.
+  if (options.crack_fills) {
+    const auto draw_child = [&](int level, int ci, int cj) {
+      const CellZ cz = m.cell_z(level, ci, cj);
+      if (!in_view(box_of(level, ci, cj, cz))) return;
+      marks[m.cell_id(level, ci, cj)] = stamp | kDrawn;
+      by_level[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
+    };
+    for (int k = m.levels - 1; k >= 2; --k) {
+      auto& list = by_level[static_cast<std::size_t>(k)];
+      for (std::size_t q = 0; q < list.size(); ++q) {
+        const int ci = static_cast<int>(list[q] >> 32), cj = static_cast<int>(list[q] & 0xFFFFFFFFu);
+        if (state(m.cell_id(k, ci, cj)) != kDrawn) continue;
+        const int pi = ci / 2, pj = cj / 2, pc = m.cells_at(k - 1);
+        const int nbr[4][2] = {{pi - 1, pj}, {pi + 1, pj}, {pi, pj - 1}, {pi, pj + 1}};
+        for (const auto& nb : nbr) {
+          if (nb[0] < 0 || nb[1] < 0 || nb[0] >= pc || nb[1] >= pc) continue;
+          // The drawn cell covering the neighbour at k - 2 or coarser, if any.
+          int level = k - 2, x = nb[0] / 2, y = nb[1] / 2;
+          while (level >= 0 && state(m.cell_id(level, x, y)) == 0) {
+            --level;
+            x /= 2;
+            y /= 2;
+          }
+          if (level < 0 || state(m.cell_id(level, x, y)) != kDrawn) continue;
+          // Refine it and its descendants over the neighbour down to level k - 2.
+          for (; level <= k - 2; ++level) {
+            marks[m.cell_id(level, x, y)] = stamp | kRefined;
+            ++frame.balanced_cells;
+            const int shift = k - 2 - level;  // from level + 1 to the neighbour's level k - 1
+            const int tx = nb[0] >> shift, ty = nb[1] >> shift;
+            for (int c = 0; c < 4; ++c) {
+              const int cx = 2 * x + (c & 1), cy = 2 * y + (c >> 1);
+              if (level + 1 <= k - 2 && cx == tx && cy == ty) continue;  // refined in the next round
+              draw_child(level + 1, cx, cy);
+            }
+            x = tx;
+            y = ty;
+            if (level + 1 > k - 2) break;
+          }
+        }
+      }
+    }
+  }
+
+  // Pass 3, the order: walk the tree again by the decisions above, the far side of every split
+  // first, collecting drawn cells and slots. Items on the stack are pushed in reverse of the
+  // order they are to come out in.
   auto& leaves = frame.leaves_;
   stack.clear();
   leaves.clear();
@@ -366,8 +435,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     for (int side = 3; side >= 0; --side) {
       if (m.outside[side] < 0) continue;
       const std::uint64_t slot = pack_slot(m.outside[side]);
-      const bool slot_near = eye_beyond[side];
-      if (slot_near == back_to_front) {
+      if (eye_beyond[side] == back_to_front) {
         order[count++] = slot;  // drawn after everything inside
       } else {
         std::move_backward(order, order + count, order + count + 1);
@@ -389,91 +457,46 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const int ci = ci_of(item), cj = cj_of(item);
     const int s = m.cell_size(level), half = s / 2;
     const int i0 = ci * s, j0 = cj * s;
-    ++frame.nodes_visited;
-    if (kind == kHalf) {  // the y split of one x half of a square; its box is its two children's
+    if (kind == kHalf) {  // the y split of one x half of a square
       const int a = half_of(item);
-      const int hi0 = i0 + a * half;
-      const CellZ z0 = m.cell_z(level + 1, 2 * ci + a, 2 * cj), z1 = m.cell_z(level + 1, 2 * ci + a, 2 * cj + 1);
-      const float top = std::max({z0.zmax, z1.zmax, content_top(level + 1, 2 * ci + a, 2 * cj),
-                                  content_top(level + 1, 2 * ci + a, 2 * cj + 1)});
-      if (options.cull && box_outside(planes,
-                                      glm::vec3(static_cast<float>(m.xs[hi0]), static_cast<float>(m.ys[j0]), std::min(z0.zmin, z1.zmin)),
-                                      glm::vec3(static_cast<float>(m.xs[hi0 + half]), static_cast<float>(m.ys[j0 + s]), top)))
-        continue;
-      const bool eye_north = e.y >= m.ys[j0 + half];
       const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
       const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
-      if (eye_north) push_pair(south, north); else push_pair(north, south);
+      if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
       continue;
     }
-    // A square: a top cell (always split) or an LOD cell.
-    const CellZ cz = m.cell_z(level, ci, cj);
-    const glm::vec3 lo(static_cast<float>(m.xs[i0]), static_cast<float>(m.ys[j0]), cz.zmin);
-    const glm::vec3 hi(static_cast<float>(m.xs[i0 + s]), static_cast<float>(m.ys[j0 + s]), cz.zmax);
-    const float top = std::max(hi.z, content_top(level, ci, cj));
-    if (options.cull && box_outside(planes, lo, glm::vec3(hi.x, hi.y, top))) continue;
-    bool refine = level < m.levels - 1;
-    const CellContent* content = nullptr;
+    // A square: a top cell (always split, if in view) or an LOD cell as decided.
+    bool refine = true;
     if (level >= 0) {
-      if (refine && !options.full_res) {
-        if (options.metric == LodMetric::kError) {
-          const double dist = std::max(box_distance(e, lo, hi), camera.near_plane);
-          refine = cz.error * focal_px / dist > options.threshold_px;
-        } else {
-          refine = box_area_px(camera, f, r, u, focal_px, lo, hi) > options.threshold_px;
-        }
-      }
-      if (!m.content_index.empty()) {
-        const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
-        if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
-      }
+      const std::uint32_t st = state(m.cell_id(level, ci, cj));
+      if (st == 0) continue;  // out of view
+      refine = st == kRefined;
+    } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
+      continue;
     }
+    const CellContent* content = content_of(level, ci, cj);
     // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
     // eye is below the plane z = zmax they are far), the terrain part, the pieces above (when
     // the eye is above that plane they are near). Pushed in reverse.
-    const bool above_near = e.z >= static_cast<double>(cz.zmax);
+    const bool above_near = e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
     const bool above_first = content && content->above >= 0 && above_near != back_to_front;
     const bool above_last = content && content->above >= 0 && !above_first;
     if (above_last) stack.push_back(pack_slot(content->above));
     if (refine) {
-      const bool eye_east = e.x >= m.xs[i0 + half];
       const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
-      if (eye_east) push_pair(west, east); else push_pair(east, west);
+      if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
     } else {
       if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
         lazy.build_pending(static_cast<std::size_t>(content->low));
       }
       stack.push_back(pack(kLeaf, level_index, ci, cj));
-      frame.stamp_[m.cell_id(level, ci, cj)] = stamp;
       ++frame.lod_histogram[static_cast<std::size_t>(level)];
       ++frame.leaves;
     }
     if (above_first) stack.push_back(pack_slot(content->above));
   }
 
-  // Which skirts can show a crack. With the eye above the ground, a ray reaching a gap under
-  // the near cell's edge has crossed that cell's surface first, so only the skirts of cells
-  // beyond a boundary plane (the plane facing the eye) can show; below the ground, only the
-  // others. Near the ground (within the largest error of the level-0 cell under the eye),
-  // both kinds are drawn.
-  bool draw_facing = options.skirts, draw_away = options.skirts;
-  if (options.skirts) {
-    const auto clamp_index = [](const std::vector<double>& v, double x) {
-      const auto it = std::upper_bound(v.begin(), v.end(), x);
-      return static_cast<int>(std::clamp<std::ptrdiff_t>(it - v.begin() - 1, 0, static_cast<std::ptrdiff_t>(v.size()) - 2));
-    };
-    const int i = clamp_index(m.xs, e.x), j = clamp_index(m.ys, e.y);
-    const float ground = std::max({m.z(i, j), m.z(i + 1, j), m.z(i, j + 1), m.z(i + 1, j + 1)});
-    const float low = std::min({m.z(i, j), m.z(i + 1, j), m.z(i, j + 1), m.z(i + 1, j + 1)});
-    const int s0 = m.cell_size(0);
-    const float margin = m.level0_error[static_cast<std::size_t>((j / s0) * m.cells_at(0) + i / s0)];
-    if (e.z > ground + margin) draw_away = false;
-    if (e.z < low - margin) draw_facing = false;
-  }
-
-  // Pass 2: expand each drawn cell into its skirts and triangles, and each slot into its
+  // Pass 4: expand each drawn cell into its crack fills and triangles, and each slot into its
   // polygons, in order.
-  const auto count = m.lattice_count();
   // Triangles are written through a cursor into buffers opened to their full capacity (grown
   // by doubling when a view needs more) and cut to size at the end: no per-triangle
   // bookkeeping of std::vector, and no allocation once the Frame is warm.
@@ -491,15 +514,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     out[2] = c;
     frame.level[triangles++] = level;
   };
-  // A quad under the edge a-b; `bottom` is the offset of the bottoms for its direction.
-  auto emit_skirt = [&](std::uint32_t a, std::uint32_t b, std::uint32_t bottom) {
-    emit(a, bottom + a, bottom + b, kSkirtLevel);
-    emit(a, bottom + b, b, kSkirtLevel);
-    frame.skirt_triangles += 2;
-  };
   // A slot's small BSP: the far side of each plane first.
   auto emit_store = [&](const BspStore& store) {
-    const auto ref = [](std::uint32_t v) { return v; };
     auto& st = frame.leaf_stack_;
     st.clear();
     if (store.root >= 0) st.push_back(store.root);
@@ -511,8 +527,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         const BspNode& bn = store.nodes[static_cast<std::size_t>(top & ~kEmitBit)];
         for (std::uint32_t k = 0; k < bn.count; ++k) {
           const Polygon& p = store.polys[bn.first + k];
-          const std::uint32_t a = ref(store.refs[p.first]);
-          for (std::uint32_t q = 1; q + 1 < p.count; ++q) emit(a, ref(store.refs[p.first + q]), ref(store.refs[p.first + q + 1]), p.level);
+          const std::uint32_t a = store.refs[p.first];
+          for (std::uint32_t q = 1; q + 1 < p.count; ++q) emit(a, store.refs[p.first + q], store.refs[p.first + q + 1], p.level);
         }
         continue;
       }
@@ -532,37 +548,43 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
     const int level = level_index_of(item) - m.top;
     const int ci = ci_of(item), cj = cj_of(item);
-    const int s = m.cell_size(level), cells = m.cells_at(level);
+    const int s = m.cell_size(level), cells = m.cells_at(level), h = s / 2;
     const int i0 = ci * s, j0 = cj * s, i1 = i0 + s, j1 = j0 + s;
     const std::uint32_t sw = m.vertex(i0, j0), se = m.vertex(i1, j0), ne = m.vertex(i1, j1), nw = m.vertex(i0, j1);
 
-    // Skirts: only where the same-level neighbour was not drawn this frame.
+    // Crack fills: where the same-level neighbour is refined, balance put it one level finer,
+    // so the gap between this cell's edge and the neighbour's is exactly the triangle (corner,
+    // the edge's middle sample, corner), in the shared boundary plane. Ordered like the plane:
+    // before the cell's triangles when it faces away from the eye, after them otherwise.
     struct Edge {
       bool needed;
       bool faces_away;  // the boundary plane lies beyond the cell's content from the eye
-      std::uint32_t a, b, bottom;
+      std::uint32_t a, mid, b;
     };
+    const bool fills = options.crack_fills && s > 1;
     const Edge edges[4] = {
-        {ci > 0 && frame.stamp_[m.cell_id(level, ci - 1, cj)] != stamp, e.x >= m.xs[i0], nw, sw, 2 * count},          // west
-        {ci + 1 < cells && frame.stamp_[m.cell_id(level, ci + 1, cj)] != stamp, e.x <= m.xs[i1], se, ne, 2 * count},  // east
-        {cj > 0 && frame.stamp_[m.cell_id(level, ci, cj - 1)] != stamp, e.y >= m.ys[j0], sw, se, count},          // south
-        {cj + 1 < cells && frame.stamp_[m.cell_id(level, ci, cj + 1)] != stamp, e.y <= m.ys[j1], ne, nw, count},  // north
+        {fills && ci > 0 && state(m.cell_id(level, ci - 1, cj)) == kRefined, e.x >= m.xs[static_cast<std::size_t>(i0)], nw, m.vertex(i0, j0 + h), sw},
+        {fills && ci + 1 < cells && state(m.cell_id(level, ci + 1, cj)) == kRefined, e.x <= m.xs[static_cast<std::size_t>(i1)], se, m.vertex(i1, j0 + h), ne},
+        {fills && cj > 0 && state(m.cell_id(level, ci, cj - 1)) == kRefined, e.y >= m.ys[static_cast<std::size_t>(j0)], sw, m.vertex(i0 + h, j0), se},
+        {fills && cj + 1 < cells && state(m.cell_id(level, ci, cj + 1)) == kRefined, e.y <= m.ys[static_cast<std::size_t>(j1)], ne, m.vertex(i0 + h, j1), nw},
     };
-    const bool first_pass_far = back_to_front;
-    for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away == first_pass_far && (edge.faces_away ? draw_away : draw_facing))
-        emit_skirt(edge.a, edge.b, edge.bottom);
+    const auto emit_fills = [&](bool away) {
+      for (const Edge& edge : edges) {
+        if (edge.needed && edge.faces_away == away) {
+          emit(edge.a, edge.mid, edge.b, kCrackLevel);
+          ++frame.crack_triangles;
+        }
+      }
+    };
+    emit_fills(back_to_front);
 
-    const CellContent* content = nullptr;
-    if (!m.content_index.empty()) {
-      const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
-      if (c >= 0) content = &m.content[static_cast<std::size_t>(c)];
-    }
+    const CellContent* content = content_of(level, ci, cj);
     if (content && content->low >= 0) {
       emit_store(m.slots[static_cast<std::size_t>(content->low)].store);
     } else {
       // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
-      const double side = (m.xs[i1] - m.xs[i0]) * (e.y - m.ys[j0]) - (m.ys[j1] - m.ys[j0]) * (e.x - m.xs[i0]);
+      const double side = (m.xs[static_cast<std::size_t>(i1)] - m.xs[static_cast<std::size_t>(i0)]) * (e.y - m.ys[static_cast<std::size_t>(j0)]) -
+                          (m.ys[static_cast<std::size_t>(j1)] - m.ys[static_cast<std::size_t>(j0)]) * (e.x - m.xs[static_cast<std::size_t>(i0)]);
       const bool eye_south_east = side < 0;
       const auto lvl = static_cast<std::int8_t>(level);
       if (eye_south_east == back_to_front) {  // draw the north-west triangle first
@@ -573,9 +595,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         emit(sw, ne, nw, lvl);
       }
     }
-    for (const Edge& edge : edges)
-      if (edge.needed && edge.faces_away != first_pass_far && (edge.faces_away ? draw_away : draw_facing))
-        emit_skirt(edge.a, edge.b, edge.bottom);
+    emit_fills(!back_to_front);
   }
   frame.indices.resize(3 * triangles);
   frame.level.resize(triangles);

@@ -54,11 +54,12 @@ struct TraversalOptions {
   bool full_res = false;        // every region at the finest level (the quality reference)
   bool front_to_back = false;   // reverse order (nearest first)
   bool cull = true;             // view-frustum culling of regions
-  bool skirts = true;           // fill cracks (off for wireframe views, where skirts only clutter)
+  bool crack_fills = true;      // balance neighbours within one level and fill the cracks between
+                                // them (off for wireframe views, where fills only clutter)
 };
 
 // Frame::level values other than terrain levels (0 coarsest, levels-1 finest).
-inline constexpr std::int8_t kSkirtLevel = -1;   // a crack skirt
+inline constexpr std::int8_t kCrackLevel = -1;   // a crack fill
 inline constexpr std::int8_t kMergedLevel = -2;  // a merged polygon (isosurface, slice, ...)
 
 // What merging did (section 4.2), for the whole tree after the last change.
@@ -94,7 +95,7 @@ struct SurfaceInput {
 // Allocator overhead and the Impl object itself are not counted.
 struct MemoryStats {
   std::size_t nodes = 0;     // tree nodes and per-level tables (cell ids, errors), plane offsets
-  std::size_t vertices = 0;  // positions of lattice samples and skirt bottoms (not merged ones)
+  std::size_t vertices = 0;  // positions of lattice samples (not merged ones)
   std::size_t merged = 0;    // everything merge() keeps: inputs, merged vertices and colours,
                              // polygons, coplanar lists, leaf BSPs
   std::size_t samples = 0;   // lattice samples, (n+1)^2: a count, not bytes
@@ -102,19 +103,21 @@ struct MemoryStats {
 };
 
 // What one traversal produced. Triangles are index triples into TerrainTree::positions(),
-// in draw order. level[t] is the LOD level of triangle t, kSkirtLevel or kMergedLevel.
+// in draw order. level[t] is the LOD level of triangle t, kCrackLevel or kMergedLevel.
 struct Frame {
   std::vector<std::uint32_t> indices;  // 3 per triangle
   std::vector<std::int8_t> level;      // 1 per triangle
   std::size_t nodes_visited = 0;
   std::size_t leaves = 0;
-  std::size_t skirt_triangles = 0;
+  std::size_t crack_triangles = 0;  // crack fills drawn
+  std::size_t balanced_cells = 0;   // cells refined only to keep neighbours within one level
   std::vector<std::size_t> lod_histogram;  // leaves drawn per level
 
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::uint64_t> stack_;
   std::vector<std::uint64_t> leaves_;
   std::vector<std::int32_t> leaf_stack_;
+  std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
 };
@@ -132,22 +135,21 @@ class TerrainTree {
   int cells() const;
   int levels() const;
 
-  // Vertex positions, three blocks of (n+1)^2: the lattice samples (index v = j * (n + 1) + i),
-  // then per sample the bottom of skirts under edges along its row ((n+1)^2 + v), then the
-  // bottom of skirts under edges along its column (2 (n+1)^2 + v). A bottom lies 1 m below
-  // the lowest sample of its lattice line within the level-0 cell edges through the sample,
-  // hence below every level's surface along those edges. Merged vertices follow, from
-  // merged_base(). The terrain blocks change only in slide(); merge() and slide() replace the
-  // merged vertices.
+  // Vertex positions: the lattice samples (index v = j * (n + 1) + i), then from merged_base()
+  // the merged vertices. The lattice changes only in slide(); merges, traversals (which build
+  // low alternatives' pieces when first drawn) and slide() change the merged vertices.
   const std::vector<glm::vec3>& positions() const;
 
   // Emits the triangles of the view into `frame` (cleared first; its capacity is reused, so
   // a frame reused across calls does not allocate once warm). Order: for back-to-front,
   // every triangle is drawn after every triangle it can be hidden by (BSP order: the far
   // side of each split plane first; inside a cell, the triangle beyond the cell's diagonal
-  // plane first; skirts on boundary planes facing away from the eye before the cell,
-  // facing it after). Cracks between neighbours at different levels are filled with skirts:
-  // vertical quads in the shared boundary plane hanging to the skirt-bottom vertices.
+  // plane first; crack fills on boundary planes facing away from the eye before the cell,
+  // facing it after). The LOD choice (options.metric and threshold) is then balanced so that
+  // drawn neighbours differ by at most one level, and each crack between a cell and its
+  // finer neighbour is filled exactly by the vertical triangle (corner, the edge's middle
+  // sample, corner) in their shared boundary plane: lattice samples only, within both cells'
+  // z ranges.
   // Culling (options.cull) tests each region's box holding everything drawn in it: its
   // terrain and the merged pieces kept in its subtree. The LOD choice uses the terrain's own
   // box and error, so merging never changes which terrain is drawn. A cell drawn low for the

@@ -23,7 +23,7 @@
 namespace terravol::mrbsp {
 
 // Terrain figures of one cell: the range of its full-resolution samples (every alternative
-// and every skirt top of the region lies within it) and the largest vertical error of its low
+// and every crack fill of the region lies within it) and the largest vertical error of its low
 // alternative against them (0 at the finest level, unused at top levels).
 struct CellZ {
   float zmin = 0.0f, zmax = 0.0f, error = 0.0f;
@@ -153,7 +153,6 @@ struct TerrainTree::Impl {
   std::vector<std::vector<CellZ>> cellz;
   std::vector<std::uint32_t> level_offset;  // first global cell id of each LOD level (>= 0)
   std::uint32_t total_cells = 0;            // cells of all LOD levels
-  std::vector<float> level0_error;          // per level-0 cell: the largest error of any cell inside it
 
   // Merged content. Surfaces by id; slots sorted by key; cell content by global cell id (top
   // levels by level and index in top_content).
@@ -177,7 +176,7 @@ struct TerrainTree::Impl {
   }
   std::uint32_t vertex(int i, int j) const { return static_cast<std::uint32_t>(j * (n + 1) + i); }
   std::uint32_t lattice_count() const { return static_cast<std::uint32_t>((n + 1) * (n + 1)); }
-  std::uint32_t merged_base() const { return 3 * lattice_count(); }
+  std::uint32_t merged_base() const { return lattice_count(); }
   float z(int i, int j) const { return positions[vertex(i, j)].z; }
   // The figures of a cell at any level >= -top; the finest level's from its four samples.
   CellZ cell_z(int level, int ci, int cj) const;

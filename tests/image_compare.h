@@ -83,9 +83,11 @@ inline bool same_color(const Rgb8& a, const Rgb8& b, int tolerance) {
   return true;
 }
 
-// Share (0..1) of pixels whose colours differ by more than `tolerance` in some channel.
-// Precondition: the same size.
+// Share (0..1) of pixels whose colours differ by more than `tolerance` in some channel; 1 when
+// the sizes differ or an image is missing (empty), so that a comparison with a failed render
+// fails instead of reading out of bounds.
 inline double differing_share(const Image& a, const Image& b, int tolerance) {
+  if (a.width != b.width || a.height != b.height || a.pixels.empty() || a.pixels.size() != b.pixels.size()) return 1.0;
   std::size_t differ = 0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) differ += !same_color(a.pixels[i], b.pixels[i], tolerance);
   return a.pixels.empty() ? 0.0 : static_cast<double>(differ) / static_cast<double>(a.pixels.size());

@@ -120,7 +120,7 @@ void run_fly(const FlyOptions& o) {
                                 std::to_string(height * factor) + " is too large to render");
   }
   mrbsp::TraversalOptions traversal = st.traversal;
-  traversal.skirts = true;
+  traversal.crack_fills = true;
   const double default_threshold = style.threshold.value_or(mrbsp::default_threshold(traversal.metric));
   // Thresholds are in output pixels; the supersampled image has factor times as many per side.
   const double threshold_scale = traversal.metric == mrbsp::LodMetric::kError ? factor : factor * factor;

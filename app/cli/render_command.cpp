@@ -84,7 +84,7 @@ void run_render(const RenderOptions& o) {
   settings.haze_distance = settings.lod_colors ? 0.0 : st.haze_km * 1000.0;
   mrbsp::TraversalOptions traversal = st.traversal;
   traversal.full_res = o.full_res;
-  traversal.skirts = !settings.wireframe;  // skirts patch cracks in filled drawing only
+  traversal.crack_fills = !settings.wireframe;  // crack fills matter in filled drawing only
 
   scene::SceneSpec scene;
   scene.dems = o.dems;
@@ -134,7 +134,7 @@ void run_render(const RenderOptions& o) {
     j["vertices"] = tree.positions().size();
     j["triangles"] = f.triangles;
     j["merged_triangles"] = f.merged_triangles;
-    j["skirt_triangles"] = view.last_frame().skirt_triangles;
+    j["crack_triangles"] = view.last_frame().crack_triangles;
     j["nodes_visited"] = f.nodes_visited;
     j["leaves"] = view.last_frame().leaves;
     j["lod_histogram"] = view.last_frame().lod_histogram;
@@ -189,7 +189,7 @@ void add_render_command(CLI::App& app) {
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
   cmd->add_option("--background", raw->background, "Uniform background R,G,B (0-255) instead of the sky");
   cmd->add_flag("--wireframe", o.wireframe, "Draw triangle edges only");
-  cmd->add_flag("--lod-colors", o.lod_colors, "Colour each LOD level (skirts grey)");
+  cmd->add_flag("--lod-colors", o.lod_colors, "Colour each LOD level (crack fills grey)");
   cmd->add_flag("--full-res", o.full_res, "Every region at full resolution");
   cmd->add_flag("--agl", o.agl, "ALT is metres above the ground under the camera");
   cmd->add_flag("--force", o.force, "Replace existing output files");

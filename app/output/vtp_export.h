@@ -13,7 +13,7 @@ namespace terravol::app::output {
 // Writes the triangles of `scene` (TerrainRenderer::scene()) exactly as drawn: the same
 // triangles in draw order, with only the points they use, renumbered in order of first use.
 // Coordinates are the scene frame's (metres). Point data: "rgba" (4 x uint8) and "normals";
-// cell data: "level" (LOD level, -1 for crack skirts) and, with --lod-colors, "lod_rgba".
+// cell data: "level" (LOD level, -1 for crack fills) and, with --lod-colors, "lod_rgba".
 // Field data: camera_position, camera_focal_point, camera_view_up (3 doubles each, scene
 // frame), camera_view_angle (vertical, degrees), camera_clipping_range, background (3 x uint8,
 // 0..255; the bottom colour of a gradient) and, for a gradient sky, background_top.

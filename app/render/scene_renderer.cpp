@@ -132,7 +132,7 @@ std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::Camer
 
 // Reads `next` from the mosaic (under its lock) in `frame`; with `shading`, shades it too and,
 // with terrain_vertices > 0 (a tree without merged polygons, whose vertices are the lattice's
-// and the skirts'), makes the vertices' shading. Touches nothing of the pipeline, so it may run
+// only), makes the vertices' shading. Touches nothing of the pipeline, so it may run
 // on a worker thread while the pipeline draws.
 SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
                                                           const scene::WindowChoice& next, const io::SceneFrame& frame,

@@ -270,7 +270,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     split_merged_.clear();
     split_levels_.clear();
     for (std::size_t t = 0; 3 * t < frame.indices.size(); ++t) {
-      const int lv = t < frame.level.size() ? frame.level[t] : mrbsp::kSkirtLevel;
+      const int lv = t < frame.level.size() ? frame.level[t] : mrbsp::kCrackLevel;
       auto& to = lv == mrbsp::kMergedLevel ? split_merged_ : split_terrain_;
       to.insert(to.end(), frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
                 frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
@@ -287,7 +287,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   vtkNew<vtkSignedCharArray> level;
   level->SetName("level");
   level->SetNumberOfValues(triangles);
-  std::fill_n(level->GetPointer(0), triangles, static_cast<signed char>(mrbsp::kSkirtLevel));
+  std::fill_n(level->GetPointer(0), triangles, static_cast<signed char>(mrbsp::kCrackLevel));
   std::copy(levels->begin(), levels->begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(levels->size()), triangles),
             level->GetPointer(0));
   poly_->GetCellData()->AddArray(level);
@@ -301,8 +301,8 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     for (vtkIdType t = 0; t < triangles; ++t) {
       const int lv = level->GetValue(t);
       const std::uint32_t* v = &(*terrain)[static_cast<std::size_t>(3 * t)];
-      if (lv == mrbsp::kSkirtLevel) {
-        rgba[t] = scene::kSkirtColor;
+      if (lv == mrbsp::kCrackLevel) {
+        rgba[t] = scene::kCrackColor;
         continue;
       }
       if (lv < 0) {  // merged polygons keep their own colour

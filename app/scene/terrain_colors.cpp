@@ -83,7 +83,7 @@ Rgba lod_color(int level) {
       {150, 100, 70, 255},   // brown
       {230, 230, 230, 255},  // white
   }};
-  if (level < 0) return kSkirtColor;
+  if (level < 0) return kCrackColor;
   return kLevels[static_cast<std::size_t>(level) % kLevels.size()];
 }
 

@@ -51,9 +51,8 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
                              const ShadingOptions& options);
 
 // The attributes of the tree's vertices (TerrainTree::positions()): vertex v below
-// `terrain_vertices` (TerrainTree::merged_base()) is a lattice sample or a skirt bottom hanging
-// under sample v % (n+1)^2, and copies that sample's attributes (so a skirt has the colours of
-// the edge it hangs from); the vertices after it are merged polygons', with `merged_colors`,
+// `terrain_vertices` (TerrainTree::merged_base()) is lattice sample v and copies its
+// attributes; the vertices after it are merged polygons', with `merged_colors`,
 // normal +z, shade 1 and texture coordinates (-1, -1) (the renderer draws their own colour
 // there, not the texture). Precondition: lattice from shade_terrain.
 TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
@@ -66,8 +65,8 @@ Rgba tint_of(float height, Tint tint, float lo, float hi);
 // --lod-colors: a distinct colour per LOD level (0 coarsest), cycling after 10 levels; never
 // magenta-like (green channel > 60), so a magenta background shows every crack.
 Rgba lod_color(int level);
-// The colour of crack skirts (Frame::level -1) under --lod-colors: neutral grey.
-inline constexpr Rgba kSkirtColor{150, 150, 150, 255};
+// The colour of crack fills (Frame::level -1) under --lod-colors: neutral grey.
+inline constexpr Rgba kCrackColor{150, 150, 150, 255};
 
 // The sky behind the terrain as VTK's linear background gradient (bottom to top of the image):
 // the haze colour kHorizon at the horizon line, deepening toward kZenith with elevation, so

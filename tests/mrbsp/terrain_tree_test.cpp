@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
@@ -25,7 +26,7 @@ Camera looking_down_from(double x, double y, double z) {
   return c;
 }
 
-TEST(TerrainTree, FullResolutionOfAFlatGridIsTwoTrianglesPerCellWithoutSkirts) {
+TEST(TerrainTree, FullResolutionOfAFlatGridIsTwoTrianglesPerCellWithoutCrackFills) {
   const TestWindow w(4, [](int, int) { return 10.0f; });
   const TerrainTree tree(w.view(), 3);
   Frame f;
@@ -34,7 +35,7 @@ TEST(TerrainTree, FullResolutionOfAFlatGridIsTwoTrianglesPerCellWithoutSkirts) {
   o.cull = false;
   tree.traverse(looking_down_from(200, 200, 1000), o, f);
   EXPECT_EQ(f.indices.size(), 4u * 4u * 2u * 3u);
-  EXPECT_EQ(f.skirt_triangles, 0u);
+  EXPECT_EQ(f.crack_triangles, 0u);
   EXPECT_EQ(f.leaves, 16u);
   EXPECT_EQ(f.lod_histogram, (std::vector<std::size_t>{0, 0, 16}));
 }
@@ -48,27 +49,17 @@ TEST(TerrainTree, FlatTerrainNeedsOnlyTheCoarsestLevelUnderTheErrorMetric) {
   tree.traverse(looking_down_from(400, 400, 50), o, f);
   EXPECT_EQ(f.leaves, 4u);
   EXPECT_EQ(f.indices.size(), 4u * 2u * 3u);
-  // Root split, two splits, four cells: seven nodes.
-  EXPECT_EQ(f.nodes_visited, 7u);
+  // The root (a top cell) and its four level-0 cells.
+  EXPECT_EQ(f.nodes_visited, 5u);
 }
 
-TEST(TerrainTree, PositionsHoldTheLatticeThenSkirtBottomsBelowEverySample) {
+TEST(TerrainTree, PositionsAreTheLatticeSamples) {
   const TestWindow w(4, [](int i, int j) { return static_cast<float>(i * 10 + j); });
   const TerrainTree tree(w.view(), 2);
   const auto& p = tree.positions();
-  ASSERT_EQ(p.size(), 3u * 25u);
+  ASSERT_EQ(p.size(), 25u);
+  EXPECT_EQ(tree.merged_base(), 25u);
   EXPECT_EQ(p[7], glm::vec3(200.0f, 100.0f, 21.0f));
-  for (std::size_t v = 0; v < 25; ++v) {
-    for (std::size_t block : {25u, 50u}) {
-      EXPECT_EQ(p[block + v].x, p[v].x);
-      EXPECT_EQ(p[block + v].y, p[v].y);
-      EXPECT_LT(p[block + v].z, p[v].z);
-    }
-  }
-  // Level 0 has cells of 2 x 2: sample (i=3, j=1) lies in row 1's segment i in [2, 4]
-  // (heights 21, 31, 41) and in column 3's segment j in [0, 2] (heights 30, 31, 32).
-  EXPECT_EQ(p[25 + 8].z, 21.0f - 1.0f);
-  EXPECT_EQ(p[50 + 8].z, 30.0f - 1.0f);
 }
 
 TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
@@ -118,7 +109,7 @@ TEST(TerrainTree, WarmTraversalReusesTheFramesBuffers) {
   }
 }
 
-TEST(TerrainTree, SkirtsCanBeLeftOut) {
+TEST(TerrainTree, CrackFillsCanBeLeftOut) {
   const TestWindow w(16, [](int i, int j) { return static_cast<float>((i * 37 + j * 11) % 50); });
   const TerrainTree tree(w.view(), 4);
   Camera c = looking_down_from(800, -600, 300);
@@ -128,11 +119,60 @@ TEST(TerrainTree, SkirtsCanBeLeftOut) {
   o.threshold_px = 20.0f;
   Frame with, without;
   tree.traverse(c, o, with);
-  o.skirts = false;
+  o.crack_fills = false;
   tree.traverse(c, o, without);
-  ASSERT_GT(with.skirt_triangles, 0u);
-  EXPECT_EQ(without.skirt_triangles, 0u);
-  EXPECT_EQ(without.indices.size() / 3, with.indices.size() / 3 - with.skirt_triangles);
+  ASSERT_GT(with.crack_triangles, 0u);
+  EXPECT_EQ(without.crack_triangles, 0u);
+  EXPECT_EQ(std::count(without.level.begin(), without.level.end(), kCrackLevel), 0);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(with.level.begin(), with.level.end(), kCrackLevel)), with.crack_triangles);
+}
+
+// Balance and crack fills make the drawn terrain watertight: every edge of a drawn triangle
+// (crack fills included) inside the window is shared by exactly two drawn triangles, whatever
+// the thresholds and eyes, and no two drawn neighbours differ by more than one level.
+TEST(TerrainTree, DrawnTerrainIsWatertightAndNeighboursDifferByAtMostOneLevel) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> h(0.0f, 300.0f);
+  std::vector<float> heights(65 * 65);
+  for (float& v : heights) v = h(rng);
+  const TestWindow w(64, [&](int i, int j) { return heights[static_cast<std::size_t>(j * 65 + i)]; });
+  const TerrainTree tree(w.view(), 6);
+  std::uniform_real_distribution<double> xy(-1000.0, 7400.0), z(350.0, 3000.0);
+  std::size_t fills = 0, balanced = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    Camera c;
+    c.eye = {xy(rng), xy(rng), z(rng)};
+    TraversalOptions o;
+    o.cull = false;
+    o.threshold_px = 0.5f * static_cast<float>(1 << (trial % 6));
+    o.metric = trial % 3 == 2 ? LodMetric::kArea : LodMetric::kError;
+    if (o.metric == LodMetric::kArea) o.threshold_px *= 400.0f;
+    Frame f;
+    tree.traverse(c, o, f);
+    fills += f.crack_triangles;
+    balanced += f.balanced_cells;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (std::size_t t = 0; t < f.level.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        std::uint32_t a = f.indices[3 * t + k], b = f.indices[3 * t + (k + 1) % 3];
+        if (a > b) std::swap(a, b);
+        ++uses[{a, b}];
+      }
+    }
+    const auto on_border = [&](std::uint32_t v) {
+      const std::uint32_t i = v % 65, j = v / 65;
+      return i == 0 || j == 0 || i == 64 || j == 64;
+    };
+    int open = 0;
+    for (const auto& [edge, count] : uses) {
+      const bool border = on_border(edge.first) && on_border(edge.second) &&
+                          (edge.first % 65 == edge.second % 65 || edge.first / 65 == edge.second / 65);
+      if (count != (border ? 1 : 2)) ++open;
+    }
+    EXPECT_EQ(open, 0) << "trial " << trial;
+  }
+  EXPECT_GT(fills, 0u);
+  EXPECT_GT(balanced, 0u) << "the test must reach cases balance changes";
 }
 
 TEST(TerrainTree, RejectsBadWindowsAndLevels) {
@@ -175,7 +215,7 @@ TEST(TerrainTree, EmittedOrderIsBackToFrontFromRandomEyes) {
   const TerrainTree tree(w.view(), 4);
   std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(-200.0, 900.0);
   Frame f;
-  std::size_t skirts = 0, mixed_levels = 0;
+  std::size_t fills = 0, mixed_levels = 0;
   for (int trial = 0; trial < 60; ++trial) {
     glm::dvec3 eye(xy(rng), xy(rng), z(rng));
     if (trial % 4 == 0) eye.x = 800.0;  // exactly on the root's split plane
@@ -188,12 +228,12 @@ TEST(TerrainTree, EmittedOrderIsBackToFrontFromRandomEyes) {
     o.threshold_px = 2.0f * static_cast<float>(1 << (trial % 7));
     o.front_to_back = trial % 5 == 4;
     tree.traverse(c, o, f);
-    skirts += f.skirt_triangles;
+    fills += f.crack_triangles;
     mixed_levels += std::count_if(f.lod_histogram.begin(), f.lod_histogram.end(), [](std::size_t k) { return k > 0; }) > 1;
     EXPECT_EQ(order_violations(tree, f, eye, 300, rng, !o.front_to_back), 0) << "trial " << trial << " eye " << eye.x
                                                                              << "," << eye.y << "," << eye.z;
   }
-  EXPECT_GT(skirts, 0u) << "the property must be exercised with skirts";
+  EXPECT_GT(fills, 0u) << "the property must be exercised with crack fills";
   EXPECT_GT(mixed_levels, 30u) << "and with neighbours at different levels";
 }
 

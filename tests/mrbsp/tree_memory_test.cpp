@@ -38,12 +38,12 @@ Triangles random_triangles(std::uint32_t seed, int count) {
 
 float hills(int i, int j) { return 200.0f + 120.0f * std::sin(0.5f * static_cast<float>(i)) * std::cos(0.4f * static_cast<float>(j)); }
 
-TEST(TerrainTreeMemory, VerticesAreTheLatticeAndItsTwoBlocksOfSkirtBottoms) {
+TEST(TerrainTreeMemory, VerticesAreTheLattice) {
   const TestWindow w(16, hills);
   const TerrainTree tree(w.view(), 4);
   const MemoryStats m = tree.memory();
   EXPECT_EQ(m.samples, 17u * 17u);
-  EXPECT_EQ(m.vertices, 3u * 17u * 17u * sizeof(glm::vec3));
+  EXPECT_EQ(m.vertices, 17u * 17u * sizeof(glm::vec3));
   EXPECT_EQ(m.merged, 0u) << "nothing merged yet";
   EXPECT_GT(m.nodes, 0u);
   EXPECT_EQ(m.total(), m.nodes + m.vertices + m.merged);
@@ -128,15 +128,15 @@ TEST(TerrainTreeMemory, GrowsAboutFourfoldWhenTheWindowSideDoubles) {
   EXPECT_EQ(b.memory().samples, 129u * 129u);
 }
 
-// The figure in the contract: about 40 bytes per lattice sample (three positions of 12 bytes,
-// and 12 bytes per cell above the finest level, of which there is about a third per sample).
-TEST(TerrainTreeMemory, HoldsAbout40BytesPerLatticeSample) {
+// The figure in the contract: about 16 bytes per lattice sample (its position, 12 bytes, and
+// 12 bytes per cell above the finest level, of which there is about a third per sample).
+TEST(TerrainTreeMemory, HoldsAbout16BytesPerLatticeSample) {
   const TestWindow w(256, hills);
   const TerrainTree tree(w.view(), 6);
   const MemoryStats m = tree.memory();
   const double per_sample = static_cast<double>(m.total()) / static_cast<double>(m.samples);
-  EXPECT_GT(per_sample, 38.0);
-  EXPECT_LT(per_sample, 42.0);
+  EXPECT_GT(per_sample, 15.0);
+  EXPECT_LT(per_sample, 17.0);
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ inline double ray_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::
 
 // For rays from the eye in many directions: along each ray, hits must be drawn from the
 // farthest to the nearest (back-to-front) or the reverse. Hits at the same distance (shared
-// edges, coplanar skirts) are not ordered against each other. Returns the violations.
+// edges, coplanar crack fills) are not ordered against each other. Returns the violations.
 inline int order_violations(const TerrainTree& tree, const Frame& f, const glm::dvec3& eye, int rays, std::mt19937& rng,
                      bool back_to_front) {
   const auto& p = tree.positions();

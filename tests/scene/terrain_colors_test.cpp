@@ -1,4 +1,4 @@
-// app/scene/terrain_colors.h: tint, hillshade, water, skirts, LOD colours and the sky.
+// app/scene/terrain_colors.h: tint, hillshade, water, LOD colours and the sky.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -73,7 +73,7 @@ TEST(TerrainColors, LodColoursAreDistinctAndNeverMagenta) {
     EXPECT_GT(lod_color(a)[1], 60);
     for (int b = a + 1; b < 10; ++b) EXPECT_NE(lod_color(a), lod_color(b));
   }
-  EXPECT_EQ(lod_color(-1), kSkirtColor);
+  EXPECT_EQ(lod_color(-1), kCrackColor);
 }
 
 TEST(TerrainColors, SkyIsHazeAtTheHorizonAndBluerAbove) {
