@@ -36,9 +36,12 @@
 
 #include "mrbsp/tree_impl.h"
 
+#include "coverage/pyramid.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -149,6 +152,11 @@ TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::m
   }
   m.refresh(window);
 }
+
+Frame::Frame() = default;
+Frame::~Frame() = default;
+Frame::Frame(Frame&&) noexcept = default;
+Frame& Frame::operator=(Frame&&) noexcept = default;
 
 TerrainTree::~TerrainTree() = default;
 TerrainTree::TerrainTree(TerrainTree&&) noexcept = default;
@@ -281,20 +289,22 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   frame.leaves = 0;
   frame.crack_triangles = 0;
   frame.balanced_cells = 0;
+  frame.occlusion = {};
   frame.lod_histogram.assign(static_cast<std::size_t>(m.levels), 0);
-  // Per cell: the traversal's stamp << 2 | kDrawn or kRefined; anything else: not visited.
+  // Per cell: the traversal's stamp << 3 | kDrawn or kRefined, | kHidden when occlusion found
+  // it hidden; anything else: not visited.
   if (frame.stamp_.size() != m.total_cells) {
     frame.stamp_.assign(m.total_cells, 0);
     frame.current_stamp_ = 0;
   }
-  if (++frame.current_stamp_ >= (1u << 30)) {  // wrapped: clear once every 2^30 frames
+  if (++frame.current_stamp_ >= (1u << 29)) {  // wrapped: clear once every 2^29 frames
     std::fill(frame.stamp_.begin(), frame.stamp_.end(), 0);
     frame.current_stamp_ = 1;
   }
-  constexpr std::uint32_t kDrawn = 1, kRefined = 2;
-  const std::uint32_t stamp = frame.current_stamp_ << 2;
+  constexpr std::uint32_t kDrawn = 1, kRefined = 2, kHidden = 4;
+  const std::uint32_t stamp = frame.current_stamp_ << 3;
   auto& marks = frame.stamp_;
-  const auto state = [&](std::uint32_t cell) { return (marks[cell] & ~3u) == stamp ? marks[cell] & 3u : 0u; };
+  const auto state = [&](std::uint32_t cell) { return (marks[cell] & ~7u) == stamp ? marks[cell] & 3u : 0u; };
 
   const glm::dvec3 f = glm::normalize(camera.forward);
   const glm::dvec3 r = glm::normalize(glm::cross(f, camera.up));
@@ -413,30 +423,29 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
   }
 
-  // Pass 3, the order: walk the tree again by the decisions above, the far side of every split
-  // first, collecting drawn cells and slots. Items on the stack are pushed in reverse of the
-  // order they are to come out in.
-  auto& leaves = frame.leaves_;
-  stack.clear();
-  leaves.clear();
-  const auto push_pair = [&](std::uint64_t far_item, std::uint64_t near_item) {
-    stack.push_back(back_to_front ? near_item : far_item);
-    stack.push_back(back_to_front ? far_item : near_item);
-  };
-  // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
-  // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]).
-  {
+  // The decided tree in order (the far side of every split first for back_to_front, the near
+  // one otherwise): `enter(level, ci, cj)` for each LOD cell reached (false leaves it out),
+  // `out(item)` for each drawn cell (kLeaf) and slot (kEmitSlot) in order. Items on the stack
+  // are pushed in reverse of the order they are to come out in.
+  const auto walk = [&](bool b2f, auto&& enter, auto&& out) {
+    stack.clear();
+    const auto push_pair = [&](std::uint64_t far_item, std::uint64_t near_item) {
+      stack.push_back(b2f ? near_item : far_item);
+      stack.push_back(b2f ? far_item : near_item);
+    };
+    // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
+    // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]). Built from the
+    // innermost out: the window, then each boundary plane's outside slot on the far or near
+    // side of what is inside it.
     std::uint64_t order[5];
     int count = 0;
     const bool eye_beyond[4] = {e.x < m.xs.front(), e.x > m.xs.back(), e.y < m.ys.front(), e.y > m.ys.back()};
-    // Built from the innermost out: the window, then each boundary plane's outside slot on
-    // the far or near side of what is inside it.
     order[count++] = pack(kSquare, 0, 0, 0);
     for (int side = 3; side >= 0; --side) {
       if (m.outside[side] < 0) continue;
       const std::uint64_t slot = pack_slot(m.outside[side]);
-      if (eye_beyond[side] == back_to_front) {
-        order[count++] = slot;  // drawn after everything inside
+      if (eye_beyond[side] == b2f) {
+        order[count++] = slot;  // after everything inside
       } else {
         std::move_backward(order, order + count, order + count + 1);
         order[0] = slot;
@@ -444,58 +453,181 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       }
     }
     for (int k = count; k-- > 0;) stack.push_back(order[k]);
-  }
-  while (!stack.empty()) {
-    const std::uint64_t item = stack.back();
-    stack.pop_back();
-    const std::uint64_t kind = kind_of(item);
-    if (kind == kEmitSlot || kind == kLeaf) {
-      leaves.push_back(item);
-      continue;
-    }
-    const int level_index = level_index_of(item), level = level_index - m.top;
-    const int ci = ci_of(item), cj = cj_of(item);
-    const int s = m.cell_size(level), half = s / 2;
-    const int i0 = ci * s, j0 = cj * s;
-    if (kind == kHalf) {  // the y split of one x half of a square
-      const int a = half_of(item);
-      const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
-      const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
-      if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
-      continue;
-    }
-    // A square: a top cell (always split, if in view) or an LOD cell as decided.
-    bool refine = true;
-    if (level >= 0) {
-      const std::uint32_t st = state(m.cell_id(level, ci, cj));
-      if (st == 0) continue;  // out of view
-      refine = st == kRefined;
-    } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
-      continue;
-    }
-    const CellContent* content = content_of(level, ci, cj);
-    // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
-    // eye is below the plane z = zmax they are far), the terrain part, the pieces above (when
-    // the eye is above that plane they are near). Pushed in reverse.
-    const bool above_near = e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
-    const bool above_first = content && content->above >= 0 && above_near != back_to_front;
-    const bool above_last = content && content->above >= 0 && !above_first;
-    if (above_last) stack.push_back(pack_slot(content->above));
-    if (refine) {
-      const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
-      if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
-    } else {
-      if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
-        lazy.build_pending(static_cast<std::size_t>(content->low));
+    while (!stack.empty()) {
+      const std::uint64_t item = stack.back();
+      stack.pop_back();
+      const std::uint64_t kind = kind_of(item);
+      if (kind == kEmitSlot || kind == kLeaf) {
+        out(item);
+        continue;
       }
-      stack.push_back(pack(kLeaf, level_index, ci, cj));
-      ++frame.lod_histogram[static_cast<std::size_t>(level)];
-      ++frame.leaves;
+      const int level_index = level_index_of(item), level = level_index - m.top;
+      const int ci = ci_of(item), cj = cj_of(item);
+      const int s = m.cell_size(level), half = s / 2;
+      const int i0 = ci * s, j0 = cj * s;
+      if (kind == kHalf) {  // the y split of one x half of a square
+        const int a = half_of(item);
+        const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
+        const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
+        if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
+        continue;
+      }
+      // A square: a top cell (always split, if in view) or an LOD cell as decided.
+      bool refine = true;
+      if (level >= 0) {
+        const std::uint32_t st = state(m.cell_id(level, ci, cj));
+        if (st == 0 || !enter(level, ci, cj)) continue;  // out of view, or hidden
+        refine = st == kRefined;
+      } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
+        continue;
+      }
+      const CellContent* content = content_of(level, ci, cj);
+      // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
+      // eye is below the plane z = zmax they are far), the terrain part, the pieces above
+      // (when the eye is above that plane they are near). Pushed in reverse.
+      const bool above_near = e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
+      const bool above_first = content && content->above >= 0 && above_near != b2f;
+      const bool above_last = content && content->above >= 0 && !above_first;
+      if (above_last) stack.push_back(pack_slot(content->above));
+      if (refine) {
+        const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
+        if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
+      } else {
+        stack.push_back(pack(kLeaf, level_index, ci, cj));
+      }
+      if (above_first) stack.push_back(pack_slot(content->above));
     }
-    if (above_first) stack.push_back(pack_slot(content->above));
+  };
+  // A drawn cell's crack fills: where the same-level neighbour is refined, balance put it one
+  // level finer, so the gap between this cell's edge and the neighbour's is exactly the
+  // triangle (corner, the edge's middle sample, corner), in the shared boundary plane.
+  struct Edge {
+    bool needed;
+    bool faces_away;  // the boundary plane lies beyond the cell's content from the eye
+    std::uint32_t a, mid, b;
+  };
+  const auto edges_of = [&](int level, int ci, int cj, std::array<Edge, 4>& edges) {
+    const int s = m.cell_size(level), cells = m.cells_at(level), h = s / 2;
+    const int i0 = ci * s, j0 = cj * s, i1 = i0 + s, j1 = j0 + s;
+    const bool fills = options.crack_fills && s > 1;
+    edges = {{
+        {fills && ci > 0 && state(m.cell_id(level, ci - 1, cj)) == kRefined, e.x >= m.xs[static_cast<std::size_t>(i0)],
+         m.vertex(i0, j1), m.vertex(i0, j0 + h), m.vertex(i0, j0)},
+        {fills && ci + 1 < cells && state(m.cell_id(level, ci + 1, cj)) == kRefined, e.x <= m.xs[static_cast<std::size_t>(i1)],
+         m.vertex(i1, j0), m.vertex(i1, j0 + h), m.vertex(i1, j1)},
+        {fills && cj > 0 && state(m.cell_id(level, ci, cj - 1)) == kRefined, e.y >= m.ys[static_cast<std::size_t>(j0)],
+         m.vertex(i0, j0), m.vertex(i0 + h, j0), m.vertex(i1, j0)},
+        {fills && cj + 1 < cells && state(m.cell_id(level, ci, cj + 1)) == kRefined, e.y <= m.ys[static_cast<std::size_t>(j1)],
+         m.vertex(i1, j1), m.vertex(i0 + h, j1), m.vertex(i0, j1)},
+    }};
+  };
+
+  // Pass 3, occlusion (Greene 1996, sections 3-5): front to back over the decided tree, each
+  // LOD cell's box (its content's) tested against the coverage of the opaque terrain tiled
+  // so far (section 5.2, test-only tiling of the box's silhouette), and each drawn cell's
+  // terrain triangles and crack fills tiled (section 3.1). Merged polygons are translucent and
+  // never tiled. Everything tiled before a cell lies on the near side of some plane that
+  // separates it from the cell, so a cell whose box is covered is hidden by nearer opaque
+  // terrain, which the back-to-front draw puts over it: leaving it out changes no pixel.
+  // Window coordinates are computed in double precision as GL maps them (glViewport(0, 0,
+  // width, height)); llvmpipe transforms float positions with float matrices, so a pixel is
+  // claimed only when its centre is inside a triangle by more than that error (the margin),
+  // and a box is hidden only when its silhouette dilated by it is covered.
+  if (options.occlusion) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!frame.pyramid_ || frame.pyramid_->width() != camera.width || frame.pyramid_->height() != camera.height) {
+      frame.pyramid_ = std::make_unique<coverage::Pyramid>(camera.width, camera.height);
+    } else {
+      frame.pyramid_->clear();
+    }
+    coverage::Pyramid& pyramid = *frame.pyramid_;
+    const double hw = 0.5 * camera.width, hh = 0.5 * camera.height;
+    const double eye_norm = glm::length(e);
+    // Window coordinates of p; false (and nothing) when p is not beyond the near plane.
+    const auto project = [&](const glm::dvec3& p, glm::dvec2& w, double& depth) {
+      const glm::dvec3 d = p - e;
+      depth = glm::dot(d, f);
+      if (!(depth > camera.near_plane)) return false;
+      w = glm::dvec2(hw + focal_px * glm::dot(d, r) / depth, hh + focal_px * glm::dot(d, u) / depth);
+      return true;
+    };
+    // The float pipeline's error at depth `depth` for points as far as `extent` from the
+    // origin, in pixels: float32's relative precision (2^-24), times a few roundings, times
+    // the magnitudes it multiplies, projected; plus the 1/256 px snapping.
+    const auto error_px = [&](double extent, double depth) {
+      return 0.004 + 8.0 * 5.96e-8 * (extent + eye_norm) * focal_px / depth;
+    };
+    const auto tile = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      glm::dvec2 w[3];
+      double depth[3];
+      double extent = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 p(m.positions[k == 0 ? a : k == 1 ? b : c]);
+        if (!project(p, w[k], depth[k])) return;
+        extent = std::max(extent, glm::length(p));
+      }
+      pyramid.cover(w, error_px(extent, std::min({depth[0], depth[1], depth[2]})));
+      ++frame.occlusion.tiled_triangles;
+    };
+    glm::dvec2 corners[8];
+    walk(
+        false,
+        [&](int level, int ci, int cj) {
+          const CellZ cz = m.cell_z(level, ci, cj);
+          const Box b = box_of(level, ci, cj, cz);
+          double near_depth = std::numeric_limits<double>::max(), extent = 0.0;
+          for (int k = 0; k < 8; ++k) {
+            const glm::dvec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.top : b.lo.z);
+            double depth = 0.0;
+            if (!project(p, corners[k], depth)) return true;  // reaches the eye's plane: visible
+            near_depth = std::min(near_depth, depth);
+            extent = std::max(extent, glm::length(p));
+          }
+          ++frame.occlusion.tested_nodes;
+          const double dilation = error_px(extent, near_depth);
+          if (dilation > coverage::kMaxMargin || !pyramid.hidden(corners, dilation)) return true;
+          marks[m.cell_id(level, ci, cj)] |= kHidden;
+          ++frame.occlusion.culled_nodes;
+          return false;
+        },
+        [&](std::uint64_t item) {
+          if (kind_of(item) != kLeaf) return;
+          const int level = level_index_of(item) - m.top, ci = ci_of(item), cj = cj_of(item);
+          const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
+          tile(m.vertex(i0, j0), m.vertex(i0 + s, j0), m.vertex(i0 + s, j0 + s));
+          tile(m.vertex(i0, j0), m.vertex(i0 + s, j0 + s), m.vertex(i0, j0 + s));
+          std::array<Edge, 4> edges;
+          edges_of(level, ci, cj, edges);
+          for (const Edge& edge : edges)
+            if (edge.needed) tile(edge.a, edge.mid, edge.b);
+        });
+    frame.occlusion.pass_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 
-  // Pass 4: expand each drawn cell into its crack fills and triangles, and each slot into its
+  // Pass 4, the order of the draw: the decided tree, less what occlusion found hidden.
+  auto& leaves = frame.leaves_;
+  leaves.clear();
+  walk(
+      back_to_front,
+      [&](int level, int ci, int cj) {
+        const std::uint32_t cell = m.cell_id(level, ci, cj);
+        if (options.occlusion && (marks[cell] & ~7u) == stamp && (marks[cell] & kHidden)) {
+          if (state(cell) == kDrawn) ++frame.occlusion.culled_leaves;
+          return false;
+        }
+        if (state(cell) == kDrawn) {
+          const CellContent* content = content_of(level, ci, cj);
+          if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
+            lazy.build_pending(static_cast<std::size_t>(content->low));
+          }
+          ++frame.lod_histogram[static_cast<std::size_t>(level)];
+          ++frame.leaves;
+        }
+        return true;
+      },
+      [&](std::uint64_t item) { leaves.push_back(item); });
+
+  // Pass 5: expand each drawn cell into its crack fills and triangles, and each slot into its
   // polygons, in order.
   // Triangles are written through a cursor into buffers opened to their full capacity (grown
   // by doubling when a view needs more) and cut to size at the end: no per-triangle
@@ -548,26 +680,14 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
     const int level = level_index_of(item) - m.top;
     const int ci = ci_of(item), cj = cj_of(item);
-    const int s = m.cell_size(level), cells = m.cells_at(level), h = s / 2;
+    const int s = m.cell_size(level);
     const int i0 = ci * s, j0 = cj * s, i1 = i0 + s, j1 = j0 + s;
     const std::uint32_t sw = m.vertex(i0, j0), se = m.vertex(i1, j0), ne = m.vertex(i1, j1), nw = m.vertex(i0, j1);
 
-    // Crack fills: where the same-level neighbour is refined, balance put it one level finer,
-    // so the gap between this cell's edge and the neighbour's is exactly the triangle (corner,
-    // the edge's middle sample, corner), in the shared boundary plane. Ordered like the plane:
-    // before the cell's triangles when it faces away from the eye, after them otherwise.
-    struct Edge {
-      bool needed;
-      bool faces_away;  // the boundary plane lies beyond the cell's content from the eye
-      std::uint32_t a, mid, b;
-    };
-    const bool fills = options.crack_fills && s > 1;
-    const Edge edges[4] = {
-        {fills && ci > 0 && state(m.cell_id(level, ci - 1, cj)) == kRefined, e.x >= m.xs[static_cast<std::size_t>(i0)], nw, m.vertex(i0, j0 + h), sw},
-        {fills && ci + 1 < cells && state(m.cell_id(level, ci + 1, cj)) == kRefined, e.x <= m.xs[static_cast<std::size_t>(i1)], se, m.vertex(i1, j0 + h), ne},
-        {fills && cj > 0 && state(m.cell_id(level, ci, cj - 1)) == kRefined, e.y >= m.ys[static_cast<std::size_t>(j0)], sw, m.vertex(i0 + h, j0), se},
-        {fills && cj + 1 < cells && state(m.cell_id(level, ci, cj + 1)) == kRefined, e.y <= m.ys[static_cast<std::size_t>(j1)], ne, m.vertex(i0 + h, j1), nw},
-    };
+    // Crack fills, ordered like their boundary plane: before the cell's triangles when it
+    // faces away from the eye, after them otherwise.
+    std::array<Edge, 4> edges;
+    edges_of(level, ci, cj, edges);
     const auto emit_fills = [&](bool away) {
       for (const Edge& edge : edges) {
         if (edge.needed && edge.faces_away == away) {

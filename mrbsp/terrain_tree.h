@@ -14,6 +14,10 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+namespace terravol::coverage {
+class Pyramid;
+}
+
 namespace terravol::mrbsp {
 
 // The terrain window, in the scene frame (metres). Samples form an (n+1) x (n+1) lattice,
@@ -54,6 +58,12 @@ struct TraversalOptions {
   bool full_res = false;        // every region at the finest level (the quality reference)
   bool front_to_back = false;   // reverse order (nearest first)
   bool cull = true;             // view-frustum culling of regions
+  // Coverage-mask occlusion culling (Greene 1996, sections 3-5): a front-to-back pass over the
+  // LOD choice tiles the opaque terrain into a coverage pyramid and tests each region's box
+  // against it; regions found hidden are left out. Conservative: the image is the one drawn
+  // without it (a pixel is claimed only when its centre lies inside a tiled triangle by more
+  // than the projection's float error).
+  bool occlusion = false;
   bool crack_fills = true;      // balance neighbours within one level and fill the cracks between
                                 // them (off for wireframe views, where fills only clutter)
 };
@@ -102,6 +112,15 @@ struct MemoryStats {
   std::size_t total() const { return nodes + vertices + merged; }
 };
 
+// What the occlusion pass did (TraversalOptions::occlusion).
+struct OcclusionStats {
+  std::size_t tested_nodes = 0;   // region boxes tested against the pyramid
+  std::size_t culled_nodes = 0;   // of those, found hidden
+  std::size_t culled_leaves = 0;  // drawn cells left out with them
+  std::size_t tiled_triangles = 0;
+  double pass_ms = 0.0;
+};
+
 // What one traversal produced. Triangles are index triples into TerrainTree::positions(),
 // in draw order. level[t] is the LOD level of triangle t, kCrackLevel or kMergedLevel.
 struct Frame {
@@ -112,12 +131,19 @@ struct Frame {
   std::size_t crack_triangles = 0;  // crack fills drawn
   std::size_t balanced_cells = 0;   // cells refined only to keep neighbours within one level
   std::vector<std::size_t> lod_histogram;  // leaves drawn per level
+  OcclusionStats occlusion;
+
+  Frame();
+  ~Frame();
+  Frame(Frame&&) noexcept;
+  Frame& operator=(Frame&&) noexcept;
 
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::uint64_t> stack_;
   std::vector<std::uint64_t> leaves_;
   std::vector<std::int32_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
+  std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
 };
