@@ -291,8 +291,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   frame.balanced_cells = 0;
   frame.occlusion = {};
   frame.lod_histogram.assign(static_cast<std::size_t>(m.levels), 0);
-  // Per cell: the traversal's stamp << 3 | kDrawn or kRefined, | kHidden when occlusion found
-  // it hidden; anything else: not visited.
+  // Per cell: the traversal's stamp << 3 | kDrawn or kRefined; anything else: not visited.
   if (frame.stamp_.size() != m.total_cells) {
     frame.stamp_.assign(m.total_cells, 0);
     frame.current_stamp_ = 0;
@@ -301,7 +300,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     std::fill(frame.stamp_.begin(), frame.stamp_.end(), 0);
     frame.current_stamp_ = 1;
   }
-  constexpr std::uint32_t kDrawn = 1, kRefined = 2, kHidden = 4;
+  constexpr std::uint32_t kDrawn = 1, kRefined = 2;
+  constexpr std::uint32_t kWasHidden = 1, kWasOpened = 2, kWasVisible = 3;  // Frame::visibility_
   const std::uint32_t stamp = frame.current_stamp_ << 3;
   auto& marks = frame.stamp_;
   const auto state = [&](std::uint32_t cell) { return (marks[cell] & ~7u) == stamp ? marks[cell] & 3u : 0u; };
@@ -424,7 +424,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   }
 
   // The decided tree in order (the far side of every split first for back_to_front, the near
-  // one otherwise): `enter(level, ci, cj)` for each LOD cell reached (false leaves it out),
+  // one otherwise): `enter(level, ci, cj, half)` for each LOD cell reached (half -1) and each
+  // of its x halves (half 0 west, 1 east) when it is refined (false leaves it out),
   // `out(item)` for each drawn cell (kLeaf) and slot (kEmitSlot) in order. Items on the stack
   // are pushed in reverse of the order they are to come out in.
   const auto walk = [&](bool b2f, auto&& enter, auto&& out) {
@@ -467,6 +468,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       const int i0 = ci * s, j0 = cj * s;
       if (kind == kHalf) {  // the y split of one x half of a square
         const int a = half_of(item);
+        if (level >= 0 && !enter(level, ci, cj, a)) continue;  // hidden
         const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
         const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
         if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
@@ -476,7 +478,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       bool refine = true;
       if (level >= 0) {
         const std::uint32_t st = state(m.cell_id(level, ci, cj));
-        if (st == 0 || !enter(level, ci, cj)) continue;  // out of view, or hidden
+        if (st == 0 || !enter(level, ci, cj, -1)) continue;  // out of view, or hidden
         refine = st == kRefined;
       } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
         continue;
@@ -541,6 +543,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       frame.pyramid_->clear();
     }
     coverage::Pyramid& pyramid = *frame.pyramid_;
+    if (frame.visibility_.size() != 3 * static_cast<std::size_t>(m.total_cells)) frame.visibility_.assign(3 * static_cast<std::size_t>(m.total_cells), 0);
     const double hw = 0.5 * camera.width, hh = 0.5 * camera.height;
     const double eye_norm = glm::length(e);
     // Window coordinates of p; false (and nothing) when p is not beyond the near plane.
@@ -572,9 +575,52 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     glm::dvec2 corners[8];
     walk(
         false,
-        [&](int level, int ci, int cj) {
-          const CellZ cz = m.cell_z(level, ci, cj);
-          const Box b = box_of(level, ci, cj, cz);
+        [&](int level, int ci, int cj, int half) {
+          const std::uint32_t cell = m.cell_id(level, ci, cj);
+          const bool leaf = half < 0 && state(cell) == kDrawn;
+          // Bittner and Havran 2001: what this node was last frame decides whether to test it.
+          // Hierarchy updating: a node opened last frame (tested visible, not a leaf) and not a
+          // leaf now goes straight to its children, unless both of those were hidden (the
+          // pull-up: it is then a termination node again and tested). Conservative updating:
+          // a leaf visible last frame is assumed visible again with probability p_skip
+          // (decided by a hash of the cell and the frame, so runs repeat). Either way nothing
+          // that would be drawn is left out: the LOD choice and the image do not change.
+          std::uint32_t* memo = &frame.visibility_[3 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(half + 1)];
+          const auto was = [&](const std::uint32_t* v) { return *v >> 2 == frame.current_stamp_ - 1 ? *v & 3u : 0u; };
+          const auto remember = [&](std::uint32_t v) { *memo = frame.current_stamp_ << 2 | v; };
+          // The node's two children: a square's halves, a half's squares.
+          const std::uint32_t* children[2];
+          if (half < 0) {
+            children[0] = &frame.visibility_[3 * static_cast<std::size_t>(cell) + 1];
+            children[1] = &frame.visibility_[3 * static_cast<std::size_t>(cell) + 2];
+          } else {
+            for (int b = 0; b < 2; ++b) children[b] = &frame.visibility_[3 * static_cast<std::size_t>(m.cell_id(level + 1, 2 * ci + half, 2 * cj + b))];
+          }
+          const std::uint32_t last = was(memo);
+          if (options.coherence != Coherence::kOff && last == kWasOpened && !leaf &&
+              !(was(children[0]) == kWasHidden && was(children[1]) == kWasHidden)) {
+            ++frame.occlusion.skipped_tests;
+            remember(kWasOpened);
+            return true;
+          }
+          if (options.coherence == Coherence::kConservative && last == kWasVisible && leaf) {
+            std::uint64_t h = (static_cast<std::uint64_t>(cell) << 32 | frame.current_stamp_) * 0x9E3779B97F4A7C15ull;
+            h ^= h >> 31;
+            if (static_cast<double>(h >> 11) * 0x1.0p-53 < options.p_skip) {
+              ++frame.occlusion.skipped_tests;
+              remember(kWasVisible);
+              return true;
+            }
+          }
+          remember(leaf ? kWasVisible : kWasOpened);
+          Box b;
+          if (half < 0) {
+            b = box_of(level, ci, cj, m.cell_z(level, ci, cj));
+          } else {
+            const Box s0 = box_of(level + 1, 2 * ci + half, 2 * cj, m.cell_z(level + 1, 2 * ci + half, 2 * cj));
+            const Box s1 = box_of(level + 1, 2 * ci + half, 2 * cj + 1, m.cell_z(level + 1, 2 * ci + half, 2 * cj + 1));
+            b = {glm::min(s0.lo, s1.lo), glm::max(s0.hi, s1.hi), std::max(s0.top, s1.top)};
+          }
           double near_depth = std::numeric_limits<double>::max(), extent = 0.0;
           for (int k = 0; k < 8; ++k) {
             const glm::dvec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.top : b.lo.z);
@@ -586,7 +632,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           ++frame.occlusion.tested_nodes;
           const double dilation = error_px(extent, near_depth);
           if (dilation > coverage::kMaxMargin || !pyramid.hidden(corners, dilation)) return true;
-          marks[m.cell_id(level, ci, cj)] |= kHidden;
+          remember(kWasHidden);
           ++frame.occlusion.culled_nodes;
           return false;
         },
@@ -609,13 +655,16 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   leaves.clear();
   walk(
       back_to_front,
-      [&](int level, int ci, int cj) {
+      [&](int level, int ci, int cj, int half) {
         const std::uint32_t cell = m.cell_id(level, ci, cj);
-        if (options.occlusion && (marks[cell] & ~7u) == stamp && (marks[cell] & kHidden)) {
-          if (state(cell) == kDrawn) ++frame.occlusion.culled_leaves;
-          return false;
+        if (options.occlusion) {
+          const std::uint32_t memo = frame.visibility_[3 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(half + 1)];
+          if (memo == (frame.current_stamp_ << 2 | kWasHidden)) {
+            if (half < 0 && state(cell) == kDrawn) ++frame.occlusion.culled_leaves;
+            return false;
+          }
         }
-        if (state(cell) == kDrawn) {
+        if (half < 0 && state(cell) == kDrawn) {
           const CellContent* content = content_of(level, ci, cj);
           if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
             lazy.build_pending(static_cast<std::size_t>(content->low));

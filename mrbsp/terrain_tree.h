@@ -52,6 +52,8 @@ struct Camera {
 // pixels of projected box area (about as many triangles on the same views).
 constexpr float default_threshold(LodMetric metric) { return metric == LodMetric::kError ? 2.0f : 500.0f; }
 
+enum class Coherence : std::uint8_t { kOff, kUpdate, kConservative };
+
 struct TraversalOptions {
   LodMetric metric = LodMetric::kError;
   float threshold_px = default_threshold(LodMetric::kError);  // refine while the metric exceeds this
@@ -64,6 +66,12 @@ struct TraversalOptions {
   // without it (a pixel is claimed only when its centre lies inside a tiled triangle by more
   // than the projection's float error).
   bool occlusion = false;
+  // Coherence of the occlusion tests over frames drawn with the same Frame (Bittner and Havran
+  // 2001): kUpdate tests only the last frame's termination nodes (hidden cells and visible
+  // leaves; hierarchy updating with pull-up); kConservative also assumes a leaf visible last
+  // frame visible again with probability p_skip. Never changes the LOD choice or the image.
+  Coherence coherence = Coherence::kOff;
+  double p_skip = 0.5;
   bool crack_fills = true;      // balance neighbours within one level and fill the cracks between
                                 // them (off for wireframe views, where fills only clutter)
 };
@@ -115,6 +123,7 @@ struct MemoryStats {
 // What the occlusion pass did (TraversalOptions::occlusion).
 struct OcclusionStats {
   std::size_t tested_nodes = 0;   // region boxes tested against the pyramid
+  std::size_t skipped_tests = 0;  // tests coherence left out
   std::size_t culled_nodes = 0;   // of those, found hidden
   std::size_t culled_leaves = 0;  // drawn cells left out with them
   std::size_t tiled_triangles = 0;
@@ -144,6 +153,7 @@ struct Frame {
   std::vector<std::int32_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
+  std::vector<std::uint32_t> visibility_;  // per cell, then its two halves: stamp << 2 | what occlusion found
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
 };

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <random>
 #include <set>
@@ -120,6 +121,43 @@ TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
   EXPECT_GT(f.occlusion.tested_nodes, 0u);
   EXPECT_EQ(f.occlusion.culled_nodes, 0u);
   EXPECT_GT(f.leaves, 0u);
+}
+
+// Over a flight, hierarchy updating and its conservative form test fewer cells than testing
+// every one, and never leave out a triangle the frame-by-frame pass keeps (what they draw lies
+// between that and everything).
+TEST(Occlusion, CoherenceTestsFewerCellsAndKeepsEverythingVisible) {
+  const TestWindow w = ridged();
+  const TerrainTree tree(w.view(), 5);
+  Frame plain, updated, conservative;
+  std::size_t tests[3] = {0, 0, 0}, skipped = 0;
+  for (int k = 0; k < 60; ++k) {
+    const Camera c = low_eye(2000.0 + 25.0 * k, 600.0 + 10.0 * k, 250.0, 0.2 - 0.004 * k, -0.05);
+    TraversalOptions o;
+    o.occlusion = true;
+    tree.traverse(c, o, plain);
+    o.coherence = Coherence::kUpdate;
+    tree.traverse(c, o, updated);
+    o.coherence = Coherence::kConservative;
+    o.p_skip = 0.5;
+    tree.traverse(c, o, conservative);
+    tests[0] += plain.occlusion.tested_nodes;
+    tests[1] += updated.occlusion.tested_nodes;
+    tests[2] += conservative.occlusion.tested_nodes;
+    skipped += updated.occlusion.skipped_tests;
+    const std::vector<Tri> p = triangles_of(plain);
+    const std::set<Tri> ps(p.begin(), p.end());
+    for (const Frame* f : {&updated, &conservative}) {
+      const std::vector<Tri> t = triangles_of(*f);
+      const std::set<Tri> ts(t.begin(), t.end());
+      EXPECT_TRUE(std::includes(ts.begin(), ts.end(), ps.begin(), ps.end())) << "frame " << k;
+    }
+  }
+  EXPECT_GT(skipped, 0u);
+  EXPECT_LT(tests[1], tests[0]);
+  EXPECT_LT(tests[2], tests[1]);
+  std::printf("tests over the flight: every cell %zu, updating %zu (%.0f%%), conservative %zu (%.0f%%)\n", tests[0], tests[1],
+              100.0 * tests[1] / tests[0], tests[2], 100.0 * tests[2] / tests[0]);
 }
 
 }  // namespace
