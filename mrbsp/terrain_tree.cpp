@@ -234,6 +234,21 @@ bool box_outside(const std::array<Plane, 5>& planes, const glm::vec3& lo, const 
   return false;
 }
 
+// The frustum test with a mask of the planes still to test (bit k: plane k): -1 when the box
+// lies outside one of them, else the mask less the planes it lies wholly inside, which its
+// sub-boxes need not test again.
+int box_planes(const std::array<Plane, 5>& planes, const glm::vec3& lo, const glm::vec3& hi, int mask) {
+  for (int k = 0; k < 5; ++k) {
+    if (!(mask & (1 << k))) continue;
+    const Plane& p = planes[static_cast<std::size_t>(k)];
+    const glm::dvec3 far(p.n.x >= 0 ? hi.x : lo.x, p.n.y >= 0 ? hi.y : lo.y, p.n.z >= 0 ? hi.z : lo.z);
+    if (glm::dot(p.n, far) + p.d < 0) return -1;
+    const glm::dvec3 near(p.n.x >= 0 ? lo.x : hi.x, p.n.y >= 0 ? lo.y : hi.y, p.n.z >= 0 ? lo.z : hi.z);
+    if (glm::dot(p.n, near) + p.d >= 0) mask &= ~(1 << k);
+  }
+  return mask;
+}
+
 double box_distance(const glm::dvec3& e, const glm::vec3& lo, const glm::vec3& hi) {
   const glm::dvec3 q = glm::clamp(e, glm::dvec3(lo), glm::dvec3(hi));
   return glm::length(q - e);
@@ -346,8 +361,9 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   auto& by_level = frame.by_level_;
   by_level.resize(static_cast<std::size_t>(m.levels));
   for (auto& l : by_level) l.clear();
+  // Items carry the frustum planes their box still has to be tested against (bits 52-56).
   stack.clear();
-  stack.push_back(pack(kSquare, 0, 0, 0));
+  stack.push_back(pack(kSquare, 0, 0, 0) | std::uint64_t{31} << 52);
   while (!stack.empty()) {
     const std::uint64_t item = stack.back();
     stack.pop_back();
@@ -355,7 +371,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     ++frame.nodes_visited;
     const CellZ cz = m.cell_z(level, ci, cj);
     const Box box = box_of(level, ci, cj, cz);
-    if (!in_view(box)) continue;
+    const int planes_left = options.cull ? box_planes(planes, box.lo, glm::vec3(box.hi.x, box.hi.y, box.top), static_cast<int>(item >> 52) & 31) : 0;
+    if (planes_left < 0) continue;
     bool refine = level < m.levels - 1;
     if (level >= 0 && refine && !options.full_res) {
       if (options.metric == LodMetric::kError) {
@@ -370,7 +387,10 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       by_level[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
       continue;
     }
-    for (int k = 0; k < 4; ++k) stack.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)));
+    for (int k = 0; k < 4; ++k) {
+      stack.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)) |
+                      static_cast<std::uint64_t>(planes_left) << 52);
+    }
   }
 
   // Pass 2, balance: neighbours drawn at most one level apart, so that every crack is one
