@@ -61,7 +61,7 @@ CellZ TerrainTree::Impl::cell_z(int level, int ci, int cj) const {
     const float a = z(ci, cj), b = z(ci + 1, cj), c = z(ci, cj + 1), d = z(ci + 1, cj + 1);
     return {std::min(std::min(a, b), std::min(c, d)), std::max(std::max(a, b), std::max(c, d)), 0.0f};
   }
-  return cellz[static_cast<std::size_t>(level + top)][static_cast<std::size_t>(cj * cells_at(level) + ci)];
+  return cellz[cellz_offset[static_cast<std::size_t>(level + top)] + static_cast<std::size_t>(cj * cells_at(level) + ci)];
 }
 
 void TerrainTree::Impl::refresh(const TerrainWindow& w) {
@@ -87,7 +87,7 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   // other (TBB over the cells of each level).
   for (int level = 0; level + 1 < levels; ++level) {
     const int s = cell_size(level), c = cells_at(level);
-    std::vector<CellZ>& out = cellz[static_cast<std::size_t>(level + top)];
+    CellZ* out = cellz.data() + cellz_offset[static_cast<std::size_t>(level + top)];
     tbb::parallel_for(tbb::blocked_range<int>(0, c * c, 64), [&](const tbb::blocked_range<int>& range) {
       for (int k = range.begin(); k != range.end(); ++k) {
         const int i0 = (k % c) * s, j0 = (k / c) * s;
@@ -112,7 +112,7 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   // Top levels: the union of their four children.
   for (int level = -1; level >= -top; --level) {
     const int c = cells_at(level);
-    std::vector<CellZ>& out = cellz[static_cast<std::size_t>(level + top)];
+    CellZ* out = cellz.data() + cellz_offset[static_cast<std::size_t>(level + top)];
     for (int cj = 0; cj < c; ++cj)
       for (int ci = 0; ci < c; ++ci) {
         CellZ u{std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(), 0.0f};
@@ -148,7 +148,8 @@ TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::m
   }
   m.total_cells = offset;
   for (int l = -m.top; l + 1 < levels; ++l) {
-    m.cellz.emplace_back(static_cast<std::size_t>(m.cells_at(l)) * static_cast<std::size_t>(m.cells_at(l)));
+    m.cellz_offset.push_back(m.cellz.size());
+    m.cellz.resize(m.cellz.size() + static_cast<std::size_t>(m.cells_at(l)) * static_cast<std::size_t>(m.cells_at(l)));
   }
   m.refresh(window);
 }
@@ -188,8 +189,7 @@ MemoryStats TerrainTree::memory() const {
   const Impl& m = *impl_;
   MemoryStats s;
   s.samples = m.lattice_count();
-  s.nodes = held(m.level_offset) + held(m.xs) + held(m.ys) + held(m.cellz);
-  for (const auto& level : m.cellz) s.nodes += held(level);
+  s.nodes = held(m.level_offset) + held(m.xs) + held(m.ys) + held(m.cellz) + held(m.cellz_offset);
   // positions holds both: the terrain's blocks up to merged_base(), merged vertices after.
   const std::size_t terrain = std::min<std::size_t>(m.merged_base(), m.positions.capacity());
   s.vertices = terrain * sizeof(glm::vec3);
@@ -507,7 +507,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
       // eye is below the plane z = zmax they are far), the terrain part, the pieces above
       // (when the eye is above that plane they are near). Pushed in reverse.
-      const bool above_near = e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
+      const bool above_near = content && content->above >= 0 && e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
       const bool above_first = content && content->above >= 0 && above_near != b2f;
       const bool above_last = content && content->above >= 0 && !above_first;
       if (above_last) stack.push_back(pack_slot(content->above));

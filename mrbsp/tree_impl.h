@@ -150,7 +150,8 @@ struct TerrainTree::Impl {
   std::vector<double> xs, ys;
   std::vector<glm::vec3> positions;  // lattice, row bottoms, column bottoms, merged vertices
   // Per level index l + top (l = -m .. L-2): its cells' figures, row-major from the south-west.
-  std::vector<std::vector<CellZ>> cellz;
+  std::vector<CellZ> cellz;               // every level above the finest, coarsest first
+  std::vector<std::size_t> cellz_offset;  // per level index l + top: where its cells start
   std::vector<std::uint32_t> level_offset;  // first global cell id of each LOD level (>= 0)
   std::uint32_t total_cells = 0;            // cells of all LOD levels
 
