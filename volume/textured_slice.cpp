@@ -226,7 +226,8 @@ TexturedMesh textured_slice(const Volume& volume, const LatticeMapper& mapper, c
   out.texels = sheet.color;
 
   Quadtree tree(sheet);
-  tree.select(options.tolerance_m);
+  out.tolerance_m = options.tolerance_m;
+  tree.select(out.tolerance_m);
   if (options.max_triangles > 0 && tree.triangle_count() > options.max_triangles) {
     // The smallest breakpoint above the tolerance that meets the cap (the count falls as the
     // tolerance grows: a merged node has at most 8 triangles where its children had at least 8,
@@ -243,7 +244,12 @@ TexturedMesh textured_slice(const Volume& volume, const LatticeMapper& mapper, c
         lo = mid + 1;
       }
     }
-    tree.select(lo == e.end() ? std::numeric_limits<double>::infinity() : static_cast<double>(*lo));
+    if (lo != e.end()) {
+      out.tolerance_m = *lo;
+    } else if (!e.empty()) {
+      out.tolerance_m = std::max(options.tolerance_m, static_cast<double>(e.back()));  // every merge there is
+    }
+    tree.select(out.tolerance_m);
   }
 
   // Emit: one vertex per sample used, with its texel centre as texture coordinates.

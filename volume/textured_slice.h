@@ -22,6 +22,7 @@ struct TexturedMesh {
   int width = 0, height = 0;       // texels
   std::vector<glm::u8vec4> texels;  // sRGB and alpha, row-major: texel (a, b) at b * width + a,
                                     // its centre at (s, t) = ((a + 0.5) / width, (b + 0.5) / height)
+  double tolerance_m = 0.0;  // textured_slice(): the tolerance the sheet meets (SheetOptions)
 };
 
 struct SheetOptions {
@@ -55,8 +56,10 @@ struct SheetOptions {
 //   interpolates bilinearly between lattice lines. It covers exactly the cells slice() draws
 //   (never more: no cell with a missing or NaN corner, nothing outside the volume), with no
 //   crack and no T-junction: its boundary edges run along slice()'s boundary edges only.
-// - Error: every vertex of slice() lies within `options.tolerance_m` of the point of the
-//   simplified sheet at the same sheet coordinates (so within that distance of the sheet).
+// - Error: every vertex of slice() lies within `tolerance_m` of the point of the simplified
+//   sheet at the same sheet coordinates (so within that distance of the sheet), tolerance_m
+//   being options.tolerance_m or the larger one the triangle cap needed (returned in
+//   TexturedMesh::tolerance_m).
 // - Cost: linear in the lattice lines (about 20 ms for 400 x 400 lines), plus at most about
 //   20 further linear passes when the triangle cap is reached.
 // Throws std::invalid_argument as slice() does, and for a tolerance < 0 or not finite.

@@ -20,6 +20,12 @@ namespace terravol::volume::detail {
 
 namespace {
 
+// Layers of points added on each side, and how far out (in cells) a point still belongs to the
+// surface rather than to a lid: lid points lie at the outer layer (-2), the surface's own in the
+// cells of the layers (-1.5 and -0.5 for an unmerged surface).
+constexpr int kPad = 2;
+constexpr float kLid = 1.75f;
+
 bool cell_has_nan(const Volume& v, int i, int j, int k) {
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
@@ -36,13 +42,18 @@ IndexMesh mesh_at(const Volume& volume, const openvdb::FloatGrid& grid, float va
   std::vector<openvdb::Vec4I> quads;
   openvdb::tools::volumeToMesh(grid, points, triangles, quads, static_cast<double>(value), adaptivity);
 
+  // Points more than kLid cells outside the lattice are the lids' and drop their polygons; the
+  // others are clamped onto the lattice's box, so that the surface ends at its boundary as
+  // flying edges' does (the polygons inside the padding become degenerate and are dropped).
   const auto& dims = volume.lattice.dims;
   std::vector<std::uint8_t> keep(points.size(), 1);
   for (std::size_t p = 0; p < points.size(); ++p) {
     std::array<int, 3> cell{};
     for (int a = 0; a < 3; ++a) {
-      const float x = points[p][a];
-      if (!(x >= 0.0f && x <= static_cast<float>(dims[a] - 1))) keep[p] = 0;
+      float& x = points[p][a];
+      const float last = static_cast<float>(dims[a] - 1);
+      if (!(x >= -kLid && x <= last + kLid)) keep[p] = 0;
+      x = std::clamp(x, 0.0f, last);
       cell[a] = std::clamp(static_cast<int>(std::floor(x)), 0, dims[a] - 2);
     }
     if (keep[p] && has_nan && cell_has_nan(volume, cell[0], cell[1], cell[2])) keep[p] = 0;
@@ -88,20 +99,30 @@ IndexMesh vdb_isosurface(const Volume& volume, float value, std::size_t max_tria
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
 
-  // NaN points take the isovalue (as for flying edges); their cells are dropped afterwards.
-  const bool has_nan = std::any_of(volume.values.begin(), volume.values.end(), [](float x) { return std::isnan(x); });
-  std::vector<float> patched;
-  const float* data = volume.values.data();
-  if (has_nan) {
-    patched = volume.values;
-    for (float& x : patched)
-      if (std::isnan(x)) x = value;
-    data = patched.data();
-  }
-  // Every lattice point active (no value equals the background), x fastest as Volume stores it.
-  const openvdb::CoordBBox box(openvdb::Coord(0, 0, 0), openvdb::Coord(dims[0] - 1, dims[1] - 1, dims[2] - 1));
-  // Dense only reads through this pointer here (copyFromDense).
-  const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, const_cast<float*>(data));
+  // The lattice, NaN points set to the isovalue (as for flying edges; their cells are dropped
+  // afterwards), with two more layers of points on every side repeating the boundary values:
+  // OpenVDB meshes against the grid's background outside the lattice, so without them every
+  // region below the isovalue at the boundary would be closed by a lid. With them the lids
+  // lie in the outermost layer, and the surface runs straight through the inner one.
+  const int pad = kPad;
+  const openvdb::CoordBBox box(openvdb::Coord(-pad, -pad, -pad),
+                               openvdb::Coord(dims[0] - 1 + pad, dims[1] - 1 + pad, dims[2] - 1 + pad));
+  const std::array<int, 3> n{dims[0] + 2 * pad, dims[1] + 2 * pad, dims[2] + 2 * pad};
+  std::vector<float> padded(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+  bool has_nan = false;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        float x = volume.at(std::clamp(i - pad, 0, dims[0] - 1), std::clamp(j - pad, 0, dims[1] - 1),
+                            std::clamp(k - pad, 0, dims[2] - 1));
+        if (std::isnan(x)) {
+          has_nan = true;
+          x = value;
+        }
+        padded[i + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k)] = x;
+      }
+  // Every point active (no value equals the background), x fastest as Volume stores it.
+  const openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, padded.data());
   auto grid = openvdb::FloatGrid::create(std::numeric_limits<float>::max());
   openvdb::tools::copyFromDense(dense, *grid, 0.0f);
 
