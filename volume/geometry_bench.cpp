@@ -273,21 +273,34 @@ int main(int argc, char** argv) {
       const volume::Mesh exact = timed(repeat, t_exact, [&] { return volume::slice(v, mapper, spec, ground); });
       std::printf("{\"slice\": \"%s\", \"method\": \"exact\", \"triangles\": %zu, %s}\n", text.c_str(), exact.triangle_count(),
                   t_exact.json().c_str());
+      // The distance of every exact vertex from the simplified sheet: mean and largest.
+      auto sheet_error = [&](const volume::Mesh& simplified) {
+        const Surface surface(simplified);
+        double sum = 0.0, worst = 0.0;
+        for (const glm::dvec3& p : exact.vertices) {
+          const double e = surface.distance(p);
+          sum += e;
+          worst = std::max(worst, e);
+        }
+        char b[96];
+        std::snprintf(b, sizeof b, "\"mean_m\": %.2f, \"max_m\": %.2f", sum / std::max<std::size_t>(1, exact.vertices.size()), worst);
+        return std::string(b);
+      };
       for (double tol : {0.5, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0}) {
         volume::SheetOptions o;
         o.tolerance_m = tol;
         Timing t;
         const volume::TexturedMesh m = timed(repeat, t, [&] { return volume::textured_slice(v, mapper, spec, ground, o); });
-        std::printf("{\"slice\": \"%s\", \"method\": \"textured\", \"tolerance_m\": %g, \"triangles\": %zu, \"texture\": [%d, %d], %s}\n",
-                    text.c_str(), tol, m.mesh.triangle_count(), m.width, m.height, t.json().c_str());
+        std::printf("{\"slice\": \"%s\", \"method\": \"textured\", \"tolerance_m\": %g, \"triangles\": %zu, \"texture\": [%d, %d], %s, %s}\n",
+                    text.c_str(), tol, m.mesh.triangle_count(), m.width, m.height, t.json().c_str(), sheet_error(m.mesh).c_str());
       }
       for (std::size_t cap : {4000, 8000, 12000}) {
         volume::SheetOptions capped;
         capped.max_triangles = cap;
         Timing t;
         const volume::TexturedMesh m = timed(repeat, t, [&] { return volume::textured_slice(v, mapper, spec, ground, capped); });
-        std::printf("{\"slice\": \"%s\", \"method\": \"textured\", \"cap\": %zu, \"tolerance_m\": %.1f, \"triangles\": %zu, %s}\n",
-                    text.c_str(), cap, m.tolerance_m, m.mesh.triangle_count(), t.json().c_str());
+        std::printf("{\"slice\": \"%s\", \"method\": \"textured\", \"cap\": %zu, \"tolerance_m\": %.1f, \"triangles\": %zu, %s, %s}\n",
+                    text.c_str(), cap, m.tolerance_m, m.mesh.triangle_count(), t.json().c_str(), sheet_error(m.mesh).c_str());
       }
       std::fflush(stdout);
     }
