@@ -21,6 +21,9 @@ struct IndexMesh {
   std::vector<std::uint32_t> triangles;
 };
 
+// Whether lattice cell (i, j, k) (corners i..i + 1 etc.) has a NaN corner.
+bool cell_has_nan(const Volume& v, int i, int j, int k);
+
 // isosurface() before mapping (same contract, same exceptions).
 IndexMesh flying_edges(const Volume& volume, float value);
 

@@ -34,6 +34,8 @@
 
 namespace terravol::volume {
 
+using detail::cell_has_nan;
+
 namespace {
 
 struct PointKey {
@@ -52,15 +54,6 @@ struct PointKeyHash {
     return (bits(k.x) * 73856093u) ^ (bits(k.y) * 19349663u) ^ (bits(k.z) * 83492791u);
   }
 };
-
-// Whether cell (i, j, k) (corners i..i+1 etc.) has a NaN corner.
-bool cell_has_nan(const Volume& v, int i, int j, int k) {
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx)
-        if (std::isnan(v.at(i + dx, j + dy, k + dz))) return true;
-  return false;
-}
 
 // The cells a triangle with this centroid (index space) may lie in: one per axis, or the two
 // either side of a lattice plane the centroid lies on.
@@ -91,6 +84,14 @@ bool triangle_touches_nan(const Volume& v, const std::array<double, 3>& centroid
 }  // namespace
 
 namespace detail {
+
+bool cell_has_nan(const Volume& v, int i, int j, int k) {
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx)
+        if (std::isnan(v.at(i + dx, j + dy, k + dz))) return true;
+  return false;
+}
 
 IndexMesh flying_edges(const Volume& volume, float value) {
   if (!std::isfinite(value)) {

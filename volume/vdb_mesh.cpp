@@ -26,14 +26,6 @@ namespace {
 constexpr int kPad = 2;
 constexpr float kLid = 1.75f;
 
-bool cell_has_nan(const Volume& v, int i, int j, int k) {
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx)
-        if (std::isnan(v.at(i + dx, j + dy, k + dz))) return true;
-  return false;
-}
-
 // One volumeToMesh at `adaptivity`, polygons cut to the lattice and its non-NaN cells.
 IndexMesh mesh_at(const Volume& volume, const openvdb::FloatGrid& grid, float value, double adaptivity,
                   bool has_nan) {
