@@ -37,7 +37,8 @@ void append(Mesh& into, const Mesh& from);
 // small enough or max_triangles is 0. Merging into the terrain tree costs about 2 microseconds
 // per stored piece, and a triangle becomes a few dozen pieces (split by the split planes, and
 // one copy per LOD alternative), so full-resolution isosurfaces of 10^5 triangles would take
-// tens of seconds to merge. Keeps the Mesh invariants.
+// tens of seconds to merge. Keeps the Mesh invariants. Takes seconds for 200k triangles:
+// volume/reduction.h has faster reductions (this is IsoReduction::kQuadricDecimation there).
 Mesh decimate(const Mesh& mesh, std::size_t max_triangles);
 
 // ---- Isosurfaces -------------------------------------------------------------------------
@@ -113,6 +114,7 @@ struct SliceSpec {
 // Throws std::invalid_argument (one line) when the slice lies entirely outside the volume
 // (naming the volume's extent in that quantity), for an unknown colour map, an opacity outside
 // [0, 1], a non-finite value, or a missing ground function that is needed.
+// volume/textured_slice.h draws the same sheet simplified, with the colours as a texture.
 Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& spec, const GroundFunction& ground);
 
 // Parses "KIND=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI]" with KIND one of lat, lon

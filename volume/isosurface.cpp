@@ -30,8 +30,11 @@
 #include <unordered_map>
 
 #include "volume/geometry.h"
+#include "volume/index_mesh.h"
 
 namespace terravol::volume {
+
+using detail::cell_has_nan;
 
 namespace {
 
@@ -51,15 +54,6 @@ struct PointKeyHash {
     return (bits(k.x) * 73856093u) ^ (bits(k.y) * 19349663u) ^ (bits(k.z) * 83492791u);
   }
 };
-
-// Whether cell (i, j, k) (corners i..i+1 etc.) has a NaN corner.
-bool cell_has_nan(const Volume& v, int i, int j, int k) {
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx)
-        if (std::isnan(v.at(i + dx, j + dy, k + dz))) return true;
-  return false;
-}
 
 // The cells a triangle with this centroid (index space) may lie in: one per axis, or the two
 // either side of a lattice plane the centroid lies on.
@@ -89,11 +83,21 @@ bool triangle_touches_nan(const Volume& v, const std::array<double, 3>& centroid
 
 }  // namespace
 
-Mesh isosurface(const Volume& volume, const LatticeMapper& mapper, float value, glm::u8vec4 rgba) {
+namespace detail {
+
+bool cell_has_nan(const Volume& v, int i, int j, int k) {
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx)
+        if (std::isnan(v.at(i + dx, j + dy, k + dz))) return true;
+  return false;
+}
+
+IndexMesh flying_edges(const Volume& volume, float value) {
   if (!std::isfinite(value)) {
     throw std::invalid_argument(volume.name + ": the isovalue must be finite");
   }
-  Mesh mesh;
+  IndexMesh mesh;
   const auto& dims = volume.lattice.dims;
   if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2) return mesh;
 
@@ -167,21 +171,37 @@ Mesh isosurface(const Volume& volume, const LatticeMapper& mapper, float value, 
     kept.insert(kept.end(), {t[0], t[2], t[1]});
   }
 
-  // Compact to the used vertices and map them to the scene frame.
+  // Compact to the used vertices.
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> remap(unique.size(), kUnused);
   mesh.triangles.reserve(kept.size());
   for (std::uint32_t idx : kept) {
     if (remap[idx] == kUnused) {
-      remap[idx] = static_cast<std::uint32_t>(mesh.vertices.size());
+      remap[idx] = static_cast<std::uint32_t>(mesh.points.size());
       const auto& p = unique[idx];
-      const io::ScenePoint s = mapper.scene(p[0], p[1], p[2]);
-      mesh.vertices.emplace_back(s.x, s.y, s.z);
+      mesh.points.emplace_back(p[0], p[1], p[2]);
     }
     mesh.triangles.push_back(remap[idx]);
   }
-  mesh.colors.assign(mesh.vertices.size(), rgba);
   return mesh;
+}
+
+Mesh to_scene(IndexMesh&& index_mesh, const LatticeMapper& mapper, glm::u8vec4 rgba) {
+  Mesh mesh;
+  mesh.vertices.reserve(index_mesh.points.size());
+  for (const glm::dvec3& p : index_mesh.points) {
+    const io::ScenePoint s = mapper.scene(p.x, p.y, p.z);
+    mesh.vertices.emplace_back(s.x, s.y, s.z);
+  }
+  mesh.colors.assign(mesh.vertices.size(), rgba);
+  mesh.triangles = std::move(index_mesh.triangles);
+  return mesh;
+}
+
+}  // namespace detail
+
+Mesh isosurface(const Volume& volume, const LatticeMapper& mapper, float value, glm::u8vec4 rgba) {
+  return detail::to_scene(detail::flying_edges(volume, value), mapper, rgba);
 }
 
 }  // namespace terravol::volume

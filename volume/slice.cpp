@@ -16,8 +16,11 @@
 
 #include "volume/colormap.h"
 #include "volume/geometry.h"
+#include "volume/slice_sheet.h"
 
 namespace terravol::volume {
+
+using detail::SliceSheet;
 
 namespace {
 
@@ -172,7 +175,10 @@ std::string describe(const SliceSpec& spec) {
 
 }  // namespace
 
-Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& spec, const GroundFunction& ground) {
+namespace detail {
+
+SliceSheet slice_sheet(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& spec,
+                       const GroundFunction& ground) {
   if (!std::isfinite(spec.value)) throw std::invalid_argument("slice " + describe(spec) + ": the position must be finite");
   if (!(spec.opacity >= 0.0 && spec.opacity <= 1.0)) {
     throw std::invalid_argument("slice " + describe(spec) + ": opacity must be within [0, 1]");
@@ -203,45 +209,59 @@ Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& s
     return glm::u8vec4(rgb, alpha);
   };
 
-  // The sheet's vertex grid: u and v run along the two lattice axes other than the line's.
+  // The sheet's sample grid: u and v run along the two lattice axes other than the line's.
+  SliceSheet sheet;
   const int axis = line_axis(spec.kind);
-  const int ua = axis == 0 ? 1 : 0;
-  const int va = axis == 2 ? 1 : 2;
-  const int nu = volume.lattice.dims[ua], nv = volume.lattice.dims[va];
-  const std::size_t n = static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv);
-  std::vector<glm::dvec3> position(n);
-  std::vector<float> value(n, kNaN);
-  std::vector<std::uint8_t> crossed(n, 0);
+  sheet.line_axis = axis;
+  sheet.u_axis = axis == 0 ? 1 : 0;
+  sheet.v_axis = axis == 2 ? 1 : 2;
+  sheet.nu = volume.lattice.dims[sheet.u_axis];
+  sheet.nv = volume.lattice.dims[sheet.v_axis];
+  const std::size_t n = static_cast<std::size_t>(sheet.nu) * static_cast<std::size_t>(sheet.nv);
+  sheet.position.assign(n, glm::dvec3(0.0));
+  sheet.value.assign(n, kNaN);
+  sheet.usable.assign(n, 0);
+  sheet.color.assign(n, glm::u8vec4(0));
   Crossing crossing(volume, mapper, spec, ground);
   bool any = false;
-  for (int v = 0; v < nv; ++v) {
-    for (int u = 0; u < nu; ++u) {
+  for (int v = 0; v < sheet.nv; ++v) {
+    for (int u = 0; u < sheet.nu; ++u) {
       std::array<double, 3> p{};
-      p[ua] = u;
-      p[va] = v;
+      p[sheet.u_axis] = u;
+      p[sheet.v_axis] = v;
       if (!crossing.find(p)) continue;
-      const std::size_t id = static_cast<std::size_t>(v) * nu + u;
-      crossed[id] = 1;
+      const std::size_t id = sheet.index(u, v);
       any = true;
-      value[id] = trilinear(volume, p);
+      const float value = trilinear(volume, p);
+      sheet.value[id] = value;
       const io::ScenePoint s = mapper.scene(p[0], p[1], p[2]);
-      position[id] = {s.x, s.y, s.z};
+      sheet.position[id] = {s.x, s.y, s.z};
+      if (std::isnan(value)) continue;
+      sheet.usable[id] = 1;
+      sheet.color[id] = color_of(value);
     }
   }
   if (!any) throw_outside(volume, spec, crossing);
+  return sheet;
+}
 
+}  // namespace detail
+
+Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& spec, const GroundFunction& ground) {
+  const SliceSheet sheet = detail::slice_sheet(volume, mapper, spec, ground);
+  const int nu = sheet.nu, nv = sheet.nv;
+  const auto& position = sheet.position;
   Mesh mesh;
   constexpr std::uint32_t kUnused = std::numeric_limits<std::uint32_t>::max();
-  std::vector<std::uint32_t> index(n, kUnused);
+  std::vector<std::uint32_t> index(position.size(), kUnused);
   auto vertex = [&](std::size_t id) {
     if (index[id] == kUnused) {
       index[id] = static_cast<std::uint32_t>(mesh.vertices.size());
       mesh.vertices.push_back(position[id]);
-      mesh.colors.push_back(color_of(value[id]));
+      mesh.colors.push_back(sheet.color[id]);
     }
     return index[id];
   };
-  auto usable = [&](std::size_t id) { return crossed[id] != 0 && !std::isnan(value[id]); };
   auto triangle = [&](std::size_t a, std::size_t b, std::size_t c) {
     const glm::dvec3 e1 = position[b] - position[a], e2 = position[c] - position[a];
     const glm::dvec3 cr(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
@@ -251,8 +271,9 @@ Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& s
   auto length2 = [](const glm::dvec3& d) { return d.x * d.x + d.y * d.y + d.z * d.z; };
   for (int v = 0; v + 1 < nv; ++v) {
     for (int u = 0; u + 1 < nu; ++u) {
-      const std::size_t a = static_cast<std::size_t>(v) * nu + u, b = a + 1, c = b + nu, d = a + nu;
-      if (!usable(a) || !usable(b) || !usable(c) || !usable(d)) continue;
+      if (!sheet.cell_usable(u, v)) continue;
+      const std::size_t a = sheet.index(u, v), b = a + 1, c = b + static_cast<std::size_t>(nu),
+                        d = a + static_cast<std::size_t>(nu);
       if (length2(position[c] - position[a]) <= length2(position[d] - position[b])) {
         triangle(a, b, c);
         triangle(a, c, d);

@@ -20,94 +20,12 @@
 #include "io/mosaic.h"
 #include "volume/colormap.h"
 #include "volume/propagation.h"
+#include "mesh_test_util.h"
 
 namespace terravol::volume {
 namespace {
 
-constexpr double kLat0 = 45.5, kLon0 = 6.5;
-
-// A volume with the given frame whose lattice starts at the south-west-bottom corner `origin`.
-Volume make_volume(std::array<int, 3> dims, FrameKind kind, HeightRef height, std::array<double, 3> origin,
-                   std::array<double, 3> spacing) {
-  Volume v;
-  v.name = "test_field";
-  v.frame.kind = kind;
-  v.frame.height = height;
-  if (kind == FrameKind::kEnu) {
-    v.frame.origin_lat = kLat0;
-    v.frame.origin_lon = kLon0;
-    v.frame.origin_h = 500.0;
-  }
-  v.lattice.dims = dims;
-  v.lattice.origin = origin;
-  v.lattice.spacing = spacing;
-  v.values.assign(v.lattice.size(), 0.0f);
-  v.active_points = v.values.size();
-  return v;
-}
-
-// Geographic, heights above the datum: about 65 m (lon) x 62 m (lat) x 50 m cells.
-Volume geographic_volume(std::array<int, 3> dims, HeightRef height = HeightRef::kDatum) {
-  return make_volume(dims, FrameKind::kGeographic, height, {kLon0 - 0.01, kLat0 - 0.01, 100.0},
-                     {1.0 / 1200.0, 1.0 / 1800.0, 50.0});
-}
-
-// Sets every point to f(scene position of the point).
-template <class F>
-void fill(Volume& v, const LatticeMapper& m, F f) {
-  for (int k = 0; k < v.lattice.dims[2]; ++k)
-    for (int j = 0; j < v.lattice.dims[1]; ++j)
-      for (int i = 0; i < v.lattice.dims[0]; ++i) {
-        const io::ScenePoint p = m.scene(i, j, k);
-        v.values[v.lattice.index(i, j, k)] = static_cast<float>(f(glm::dvec3(p.x, p.y, p.z)));
-      }
-}
-
-// Lattice coordinates of a scene point, for geographic volumes with heights above the datum.
-glm::dvec3 lattice_of(const Volume& v, const io::SceneFrame& frame, const glm::dvec3& p) {
-  const io::Geodetic g = frame.to_geodetic({p.x, p.y, p.z});
-  const auto& l = v.lattice;
-  return {(g.lon - l.origin[0]) / l.spacing[0], (g.lat - l.origin[1]) / l.spacing[1], (g.h - l.origin[2]) / l.spacing[2]};
-}
-
-double triangle_area(const Mesh& m, std::size_t t) {
-  const glm::dvec3 a = m.vertices[m.triangles[3 * t]], b = m.vertices[m.triangles[3 * t + 1]],
-                   c = m.vertices[m.triangles[3 * t + 2]];
-  const glm::dvec3 u = b - a, w = c - a;
-  const glm::dvec3 n(u.y * w.z - u.z * w.y, u.z * w.x - u.x * w.z, u.x * w.y - u.y * w.x);
-  return 0.5 * std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-}
-
-glm::dvec3 centroid(const Mesh& m, std::size_t t) {
-  return (m.vertices[m.triangles[3 * t]] + m.vertices[m.triangles[3 * t + 1]] + m.vertices[m.triangles[3 * t + 2]]) /
-         3.0;
-}
-
-// The Mesh invariants of geometry.h.
-void expect_valid(const Mesh& m) {
-  ASSERT_EQ(m.colors.size(), m.vertices.size());
-  ASSERT_EQ(m.triangles.size() % 3, 0u);
-  std::vector<bool> used(m.vertices.size(), false);
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    const std::uint32_t a = m.triangles[3 * t], b = m.triangles[3 * t + 1], c = m.triangles[3 * t + 2];
-    ASSERT_LT(a, m.vertices.size());
-    ASSERT_LT(b, m.vertices.size());
-    ASSERT_LT(c, m.vertices.size());
-    EXPECT_TRUE(a != b && b != c && a != c) << "triangle " << t;
-    EXPECT_GT(triangle_area(m, t), 0.0) << "triangle " << t;
-    used[a] = used[b] = used[c] = true;
-  }
-  EXPECT_EQ(std::count(used.begin(), used.end(), false), 0) << "unused vertices";
-  for (const glm::dvec3& p : m.vertices) EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
-}
-
-// How many triangles use each directed edge.
-std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed_edges(const Mesh& m) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
-  for (std::size_t t = 0; t < m.triangle_count(); ++t)
-    for (int e = 0; e < 3; ++e) ++edges[{m.triangles[3 * t + e], m.triangles[3 * t + (e + 1) % 3]}];
-  return edges;
-}
+using namespace test;
 
 // ---- Isosurfaces -------------------------------------------------------------------------
 
@@ -325,27 +243,6 @@ TEST(Geometry, AppendOffsetsTheIndices) {
 }
 
 // ---- Slices ------------------------------------------------------------------------------
-
-SliceSpec at(SliceKind kind, double value) {
-  SliceSpec s;
-  s.kind = kind;
-  s.value = value;
-  return s;
-}
-
-struct Scene {
-  Volume volume;
-  io::SceneFrame frame{kLat0, kLon0};
-  GroundFunction ground;
-  LatticeMapper mapper;
-
-  Scene(Volume v, GroundFunction g = {}) : volume(std::move(v)), ground(std::move(g)), mapper(volume, frame, ground) {}
-};
-
-// A smooth terrain of 300 .. 900 m under the test volumes.
-double hills(double lat, double lon) {
-  return 600.0 + 200.0 * std::sin((lat - kLat0) * 300.0) + 100.0 * std::cos((lon - kLon0) * 250.0);
-}
 
 TEST(Slice, ConstantLatitudeSheetLiesOnItsParallel) {
   Scene s(geographic_volume({20, 15, 10}));
