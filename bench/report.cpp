@@ -137,7 +137,11 @@ void translucency_section(std::ostringstream& md, const json& results) {
     const json& r = t["responsiveness"];
     md << "\n**Responsiveness** (5): threshold change to finished frame " << spread(r["threshold_change_ms"], "%.0f")
        << " ms; slice move to finished frame " << spread(r["slice_move_ms"], "%.0f") << " ms (of which merge "
-       << spread(r["slice_move_merge_ms"], "%.0f") << " ms).\n\n";
+       << spread(r["slice_move_merge_ms"], "%.0f") << " ms); isovalue change to finished frame "
+       << (r.contains("isovalue_change_ms") ? spread(r["isovalue_change_ms"], "%.0f") : std::string("–"))
+       << " ms (of which merge "
+       << (r.contains("isovalue_change_merge_ms") ? spread(r["isovalue_change_merge_ms"], "%.0f") : std::string("–"))
+       << " ms).\n\n";
   }
 }
 

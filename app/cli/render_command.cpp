@@ -138,9 +138,19 @@ void run_render(const RenderOptions& o) {
     j["nodes_visited"] = f.nodes_visited;
     j["leaves"] = view.last_frame().leaves;
     j["lod_histogram"] = view.last_frame().lod_histogram;
+    const mrbsp::OcclusionStats& occ = view.last_frame().occlusion;
+    j["occlusion"] = {{"on", traversal.occlusion},          {"coherence", scene::coherence_name(traversal.coherence)},
+                      {"tested_nodes", occ.tested_nodes},   {"skipped_tests", occ.skipped_tests},
+                      {"culled_nodes", occ.culled_nodes},
+                      {"culled_leaves", occ.culled_leaves}, {"tiled_triangles", occ.tiled_triangles},
+                      {"pass_ms", occ.pass_ms}};
     j["volumes"] = {{"count", view.volume_count()},
                     {"input_triangles", merge.input_triangles},
                     {"tree_triangles", merge.tree_triangles},
+                    {"pieces_per_triangle", merge.input_triangles > 0 ? static_cast<double>(merge.tree_triangles) /
+                                                                            static_cast<double>(merge.input_triangles)
+                                                                      : 0.0},
+                    {"merged_bytes", tree.memory().merged},
                     {"geometry_ms", merge.geometry_ms},
                     {"merge_ms", merge.merge_ms}};
     j["camera"] = {{"lat", o.pose.lat},

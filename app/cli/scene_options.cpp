@@ -35,6 +35,8 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
   s.sun_azimuth = defaults.shading.sun_azimuth_deg;
   s.sun_elevation = defaults.shading.sun_elevation_deg;
   s.surface_triangles = defaults.surface_triangles;
+  s.occlusion = defaults.traversal.occlusion ? "on" : "off";
+  s.coherence = scene::coherence_name(defaults.traversal.coherence);
   // Each shows its default (the values just set) in --help.
   const auto option = [&cmd](const char* name, auto& value, const char* help) {
     return cmd.add_option(name, value, help)->capture_default_str();
@@ -56,8 +58,14 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
                          "Aerial perspective: distance (km) at which 63% of the colour fades to the sky; 0: none");
   s.tint_option = option("--tint", s.tint, "Terrain tint: atlas, relative (stretched to the window) or grey");
   s.surface_option = option("--surface-triangles", s.surface_triangles,
-                            "Decimate each isosurface and slice to at most this many triangles before merging "
-                            "(0: keep all)");
+                            "Reduce each isosurface to at most this many triangles before merging (0: keep all; "
+                            "slices are never reduced)");
+  s.occlusion_option = option("--occlusion", s.occlusion,
+                              "Occlusion culling of hidden terrain and volumes (Greene's coverage masks): on or off; "
+                              "the image is the same either way");
+  s.coherence_option = option("--coherence", s.coherence,
+                              "Occlusion tests reused from frame to frame (Bittner and Havran): off, update or "
+                              "conservative; with --occlusion on");
 }
 
 scene::SceneStyle given_style(const SceneArgs& args) {
@@ -79,6 +87,8 @@ scene::SceneStyle given_style(const SceneArgs& args) {
   if (given(s.sun_azimuth_option)) g.sun_azimuth = s.sun_azimuth;
   if (given(s.sun_elevation_option)) g.sun_elevation = s.sun_elevation;
   if (given(s.surface_option)) g.surface_triangles = s.surface_triangles;
+  if (given(s.occlusion_option)) g.occlusion = s.occlusion;
+  if (given(s.coherence_option)) g.coherence = s.coherence;
   if (args.no_legend) g.legend = false;
   return g;
 }

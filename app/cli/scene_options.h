@@ -16,16 +16,17 @@
 namespace terravol::app::cli {
 
 // The style options as given: --size, --lod-metric, --threshold, --order, --tint, --window,
-// --haze, --sun-azimuth, --sun-elevation, --surface-triangles. The values start at
+// --haze, --sun-azimuth, --sun-elevation, --surface-triangles, --occlusion, --coherence. The values start at
 // scene::Style's defaults (shown in --help); only the options given count (given_style).
 struct StyleArgs {
-  std::string size, metric, order, tint;
+  std::string size, metric, order, tint, occlusion, coherence;
   double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0;
   int window = 0;
   std::size_t surface_triangles = 0;
   CLI::Option *size_option = nullptr, *metric_option = nullptr, *threshold_option = nullptr,
               *order_option = nullptr, *tint_option = nullptr, *window_option = nullptr, *haze_option = nullptr,
-              *sun_azimuth_option = nullptr, *sun_elevation_option = nullptr, *surface_option = nullptr;
+              *sun_azimuth_option = nullptr, *sun_elevation_option = nullptr, *surface_option = nullptr,
+              *occlusion_option = nullptr, *coherence_option = nullptr;
 };
 
 // The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --no-legend

@@ -87,15 +87,24 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
   renderer_ = std::make_unique<TerrainRenderer>(
       tree.positions(), scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()), settings_,
       ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  renderer_->set_vertex_version(tree.merged_version());
   if (options_.legend) renderer_->set_legend(volumes_.legend());
 }
 
 SceneRenderer::~SceneRenderer() = default;
 
-void SceneRenderer::upload_vertices() {
+void SceneRenderer::sync_vertices(TerrainRenderer& renderer) const {
   const mrbsp::TerrainTree& tree = scene_->tree();
-  const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-  renderer_->replace_vertices(tree.positions(), all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  const std::vector<glm::vec3>& positions = tree.positions();
+  if (renderer.vertex_version() != tree.merged_version() || renderer.vertex_count() > positions.size()) {
+    const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
+    renderer.replace_vertices(positions, all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  } else if (renderer.vertex_count() < positions.size()) {
+    const std::size_t have = renderer.vertex_count();
+    renderer.append_merged_vertices(std::span(positions).subspan(have),
+                                    std::span(tree.merged_colors()).subspan(have - tree.merged_base()));
+  }
+  renderer.set_vertex_version(tree.merged_version());
 }
 
 namespace {
@@ -164,7 +173,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   try {
     scene_->slide(std::move(p.window));  // merges the volumes' polygons again into the moved window
   } catch (...) {
-    upload_vertices();  // the scene kept its window
+    sync_vertices(*renderer_);  // the scene kept its window: all of its vertices again
     throw;
   }
   return_freed_memory();  // the old vertices and the merge's scratch
@@ -180,6 +189,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const mrbsp::TerrainTree& tree = scene_->tree();
   if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
   renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  renderer_->set_vertex_version(tree.merged_version());
   p.vertices = {};
   return_freed_memory();  // the upload's shading copies
   last_slide_ = {p.read_ms, p.shade_ms, tree_ms, ms_since(t1)};
@@ -252,6 +262,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   scene_->tree().traverse(camera_, traversal, frame_);
   stats.traversal_ms = ms_since(t0);
   t0 = Clock::now();
+  sync_vertices(*renderer_);  // the low alternatives the traversal built appended vertices
   renderer_->set_frame(frame_);
   stats.upload_ms = ms_since(t0);
   stats.triangles = frame_.indices.size() / 3;
@@ -281,13 +292,15 @@ FrameStats SceneRenderer::render(const scene::CameraPose& pose, bool agl, double
 std::unique_ptr<TerrainRenderer> SceneRenderer::make_renderer(const RenderSettings& settings) const {
   const mrbsp::TerrainTree& tree = scene_->tree();
   const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-  return std::make_unique<TerrainRenderer>(tree.positions(), all, settings,
-                                           ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  auto renderer = std::make_unique<TerrainRenderer>(tree.positions(), all, settings,
+                                                    ColorTexture{scene_->cells() + 1, lattice_.rgba});
+  renderer->set_vertex_version(tree.merged_version());
+  return renderer;
 }
 
 const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
-  upload_vertices();
+  sync_vertices(*renderer_);
   if (options_.legend) renderer_->set_legend(volumes_.legend());
   return volumes_.figures();
 }

@@ -134,6 +134,11 @@ class SceneRenderer {
   // (terravol bench draws one traversal in several orders). It is not told of later slides or
   // merges: make it again after render() reports a slide or after remerge().
   std::unique_ptr<TerrainRenderer> make_renderer(const RenderSettings& settings) const;
+  // Brings a renderer's vertices up to the tree's: all of them again when the tree renumbered
+  // its merged vertices (TerrainTree::merged_version()), else only the tail it appended (edits,
+  // low alternatives built by the last traversal). prepare() does this for its own renderer;
+  // call it for make_renderer()'s before drawing them a frame of frame().
+  void sync_vertices(TerrainRenderer& renderer) const;
   // The lattice's shading (per sample, row 0 south): the colours the terrain is drawn in.
   const scene::TerrainShading& lattice_shading() const { return lattice_; }
 
@@ -151,7 +156,6 @@ class SceneRenderer {
     scene::TerrainShading vertices;  // of a tree without merged polygons; empty: made after the slide
     double read_ms = 0, shade_ms = 0;
   };
-  void upload_vertices();
   void slide(const scene::CameraPose& pose, FrameStats& stats);
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
   static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,

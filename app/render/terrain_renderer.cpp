@@ -427,7 +427,44 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   if (split_orders()) merged_poly_->Modified();
 }
 
+void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> positions,
+                                             std::span<const glm::u8vec4> colors) {
+  if (positions.size() != colors.size()) {
+    throw std::invalid_argument("TerrainRenderer::append_merged_vertices: " + std::to_string(positions.size()) +
+                                " positions but " + std::to_string(colors.size()) + " colours");
+  }
+  if (positions.empty()) return;
+  const auto old_count = static_cast<vtkIdType>(point_rgba_.size());
+  const auto count = old_count + static_cast<vtkIdType>(positions.size());
+  // Grows each array by the tail; Resize keeps the old values, and the capacity at least
+  // doubles, so a run of small appends (lazily built pieces, frame after frame) stays linear.
+  auto grow = [&](vtkDataArray* a, const void* from, std::size_t bytes_per_tuple) {
+    const vtkIdType capacity = a->GetSize() / std::max(a->GetNumberOfComponents(), 1);
+    if (capacity < count) a->Resize(std::max(count, 2 * capacity));
+    a->SetNumberOfTuples(count);
+    std::memcpy(static_cast<char*>(a->GetVoidPointer(0)) + old_count * bytes_per_tuple, from,
+                positions.size() * bytes_per_tuple);
+    a->Modified();
+  };
+  grow(poly_->GetPoints()->GetData(), positions.data(), sizeof(glm::vec3));
+  poly_->GetPoints()->Modified();
+  const std::vector<glm::vec3> up(positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
+  grow(poly_->GetPointData()->GetNormals(), up.data(), sizeof(glm::vec3));
+  std::vector<scene::Rgba> rgba(colors.size());
+  for (std::size_t k = 0; k < colors.size(); ++k) rgba[k] = {colors[k].r, colors[k].g, colors[k].b, colors[k].a};
+  grow(poly_->GetPointData()->GetScalars(), rgba.data(), sizeof(scene::Rgba));
+  if (texture_side_ > 0) {
+    const std::vector<glm::vec2> none(positions.size(), glm::vec2(-1.0f));
+    grow(poly_->GetPointData()->GetTCoords(), none.data(), sizeof(glm::vec2));
+  }
+  shade_.resize(shade_.size() + positions.size(), 1.0f);
+  point_rgba_.insert(point_rgba_.end(), rgba.begin(), rgba.end());
+  poly_->Modified();
+  if (split_orders()) merged_poly_->Modified();
+}
+
 void TerrainRenderer::release_vertices() {
+  vertex_version_ = ~std::uint64_t{0};  // of no tree: the next sync replaces every vertex
   poly_->SetPolys(vtkNew<vtkCellArray>());
   poly_->GetCellData()->Initialize();
   if (split_orders()) merged_poly_->SetPolys(vtkNew<vtkCellArray>());

@@ -116,6 +116,17 @@ class TerrainRenderer {
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
   void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                         const ColorTexture& texture = {});
+  // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only
+  // appended merged vertices, so only they are added: `positions` are the new tail of the
+  // tree's positions() and `colors` their merged colours (normal +z, shade 1, no texture, as
+  // vertex_shading gives merged vertices). The triangles drawn stay valid. Throws
+  // std::invalid_argument when the counts differ.
+  void append_merged_vertices(std::span<const glm::vec3> positions, std::span<const glm::u8vec4> colors);
+  std::size_t vertex_count() const { return point_rgba_.size(); }
+  // Which TerrainTree::merged_version() the vertices are of (the caller's bookkeeping:
+  // SceneRenderer::sync_vertices sets it).
+  std::uint64_t vertex_version() const { return vertex_version_; }
+  void set_vertex_version(std::uint64_t v) { vertex_version_ = v; }
   // Frees every vertex array, the triangle lists and their buffers on the GPU (host memory
   // under Mesa's llvmpipe), keeping the texture. Call it before a slide or merge that will
   // replace every vertex, so that the old vertices and the tree's merge scratch never hold
@@ -150,6 +161,7 @@ class TerrainRenderer {
   std::vector<float> shade_;      // per vertex, for --lod-colors
   std::vector<scene::Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
   int texture_side_ = 0;          // 0: no texture
+  std::uint64_t vertex_version_ = ~std::uint64_t{0};
   vtkNew<vtkPolyData> poly_;
   vtkNew<vtkImageData> texture_image_;
   vtkNew<vtkTexture> texture_;

@@ -125,7 +125,7 @@ SceneCamera camera_of(const Reader& r, const json& j) {
 
 SceneStyle style_of(const Reader& r, const json& j) {
   r.only_keys(j, "render", {"size", "threshold", "lod_metric", "order", "tint", "window", "haze_km", "sun_azimuth",
-                            "sun_elevation", "legend", "surface_triangles"});
+                            "sun_elevation", "legend", "surface_triangles", "occlusion", "coherence"});
   SceneStyle s;
   auto text = [&](const char* key, auto check) -> std::optional<std::string> {
     if (!j.contains(key)) return std::nullopt;
@@ -151,6 +151,8 @@ SceneStyle style_of(const Reader& r, const json& j) {
   s.lod_metric = text("lod_metric", [](const std::string& v) { parse_metric(v); });
   s.order = text("order", [](const std::string& v) { parse_order(v); });
   s.tint = text("tint", [](const std::string& v) { parse_tint(v); });
+  s.occlusion = text("occlusion", [](const std::string& v) { parse_on_off("occlusion", v); });
+  s.coherence = text("coherence", [](const std::string& v) { parse_coherence(v); });
   if (j.contains("window")) {
     const double w = r.number(j["window"], "render.window", 2, 32768);
     const int n = static_cast<int>(w);

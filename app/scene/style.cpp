@@ -31,7 +31,7 @@ constexpr auto kStyleKeys =
     std::make_tuple(&SceneStyle::width, &SceneStyle::height, &SceneStyle::threshold, &SceneStyle::lod_metric,
                     &SceneStyle::order, &SceneStyle::tint, &SceneStyle::window, &SceneStyle::haze_km,
                     &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend,
-                    &SceneStyle::surface_triangles);
+                    &SceneStyle::surface_triangles, &SceneStyle::occlusion, &SceneStyle::coherence);
 
 }  // namespace
 
@@ -56,7 +56,31 @@ Style resolve_style(const SceneStyle& s) {
   if (s.sun_elevation) r.shading.sun_elevation_deg = *s.sun_elevation;
   if (s.legend) r.legend = *s.legend;
   if (s.surface_triangles) r.surface_triangles = *s.surface_triangles;
+  if (s.occlusion) r.traversal.occlusion = parse_on_off("--occlusion", *s.occlusion);
+  if (s.coherence) r.traversal.coherence = parse_coherence(*s.coherence);
   return r;
+}
+
+bool parse_on_off(std::string_view option, std::string_view text) {
+  if (text == "on") return true;
+  if (text == "off") return false;
+  throw std::invalid_argument(quote(option, text) + "expected on or off");
+}
+
+mrbsp::Coherence parse_coherence(std::string_view text) {
+  if (text == "off") return mrbsp::Coherence::kOff;
+  if (text == "update") return mrbsp::Coherence::kUpdate;
+  if (text == "conservative") return mrbsp::Coherence::kConservative;
+  throw std::invalid_argument(quote("--coherence", text) + "expected off, update or conservative");
+}
+
+const char* coherence_name(mrbsp::Coherence coherence) {
+  switch (coherence) {
+    case mrbsp::Coherence::kUpdate: return "update";
+    case mrbsp::Coherence::kConservative: return "conservative";
+    case mrbsp::Coherence::kOff: break;
+  }
+  return "off";
 }
 
 std::optional<CameraPose> resolve_camera(const SceneSpec& file, const std::string* camera_text, bool fov_given,

@@ -30,7 +30,7 @@ enum class DrawOrder : std::uint8_t {
   kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
 };
 
-// Isosurfaces and slices are decimated to this many triangles each before merging (0: all).
+// Isosurfaces are reduced to this many triangles each before merging (0: all); slices never.
 inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
 
 // The "render" object of a scene file (docs/scene-file.md), or what a command line gave: every
@@ -44,6 +44,7 @@ struct SceneStyle {
   std::optional<double> haze_km, sun_azimuth, sun_elevation;
   std::optional<bool> legend;
   std::optional<std::size_t> surface_triangles;
+  std::optional<std::string> occlusion, coherence;
 };
 
 // A style with every key decided.
@@ -55,7 +56,9 @@ struct Style {
   int window = 1024;                // largest window side, cells, a power of two
   double haze_km = 60.0;            // 0: none
   bool legend = true;               // a colour legend when volumes are drawn
-  std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
+  std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface; 0: all
+  // traversal.occlusion and traversal.coherence come from "occlusion" (on | off, default off)
+  // and "coherence" (off | update | conservative, default off).
 };
 
 // The precedence table, in one place: every key set in `given` (the command line) wins over the
@@ -94,5 +97,8 @@ DrawOrder parse_order(std::string_view text);          // bsp | zbuffer | peel |
 const char* order_name(DrawOrder order);               // the inverse of parse_order
 Tint parse_tint(std::string_view text);                // atlas | relative | grey
 const char* tint_name(Tint tint);                      // the inverse of parse_tint ("grey")
+bool parse_on_off(std::string_view option, std::string_view text);  // on | off
+mrbsp::Coherence parse_coherence(std::string_view text);             // off | update | conservative
+const char* coherence_name(mrbsp::Coherence coherence);              // the inverse of parse_coherence
 
 }  // namespace terravol::app::scene

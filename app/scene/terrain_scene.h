@@ -102,11 +102,10 @@ class TerrainScene {
   float max_z() const { return max_z_; }
 
   const mrbsp::TerrainTree& tree() const { return tree_; }
-  // Merges polygons into the tree (TerrainTree::merge: replaces those merged before; slide()
-  // merges them again into the moved window).
-  mrbsp::MergeStats merge(std::span<const glm::dvec3> vertices, std::span<const glm::u8vec4> colors,
-                          std::span<const std::uint32_t> triangles) {
-    return tree_.merge(vertices, colors, triangles);
+  // Merges surfaces into the tree by id (TerrainTree::set_surfaces: each replaces what its id
+  // held, an empty one removes it; slide() merges them all again into the moved window).
+  mrbsp::MergeStats set_surfaces(std::span<const std::uint32_t> ids, std::span<const mrbsp::SurfaceInput> surfaces) {
+    return tree_.set_surfaces(ids, surfaces);
   }
   double build_ms() const { return build_ms_; }  // the tree's constructor alone, wall clock
 

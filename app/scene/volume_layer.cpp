@@ -12,6 +12,7 @@
 #include "volume/colormap.h"
 #include "volume/geometry.h"
 #include "volume/readers.h"
+#include "volume/reduction.h"
 
 namespace terravol::app::scene {
 
@@ -39,6 +40,9 @@ struct VolumeLayer::Loaded {
   GroundGrid ground;
   std::unique_ptr<volume::LatticeMapper> mapper;
   std::vector<volume::Mesh> isosurfaces, slices;
+  // Changed since the last merge_into(), each surface (isosurfaces then slices); a change of
+  // the volume's visibility changes all of them.
+  std::vector<bool> changed;
   std::array<float, 2> range{0, 1};
 
   volume::GroundFunction ground_function() const {
@@ -47,11 +51,11 @@ struct VolumeLayer::Loaded {
   std::size_t max_triangles = 0;
 
   volume::Mesh iso_mesh(const volume::IsoSpec& s) const {
-    return volume::decimate(volume::isosurface(data, *mapper, s.value, s.rgba()), max_triangles);
+    return volume::reduced_isosurface(data, *mapper, s.value, s.rgba(), max_triangles);
   }
   volume::Mesh slice_mesh(const volume::SliceSpec& s) const {
     try {
-      return volume::decimate(volume::slice(data, *mapper, s, ground_function()), max_triangles);
+      return volume::slice(data, *mapper, s, ground_function());
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(spec.file.string() + ": " + e.what());
     }
@@ -97,6 +101,7 @@ VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic&
     v->range = finite_range(v->data);
     for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
     for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
+    v->changed.assign(v->isosurfaces.size() + v->slices.size(), true);
     volumes_.push_back(std::move(v));
   }
   figures_.geometry_ms = ms_since(t0);
@@ -118,17 +123,36 @@ volume::Mesh VolumeLayer::visible_mesh() const {
 }
 
 void VolumeLayer::merge_into(TerrainScene& scene) {
-  const volume::Mesh all = visible_mesh();
+  const bool fresh = merged_tree_ != &scene.tree();
+  std::vector<std::uint32_t> ids;
+  std::vector<mrbsp::SurfaceInput> inputs;
+  figures_.input_triangles = 0;
+  for (std::size_t v = 0; v < volumes_.size(); ++v) {
+    Loaded& l = *volumes_[v];
+    const std::size_t isos = l.isosurfaces.size();
+    for (std::size_t k = 0; k < l.changed.size(); ++k) {
+      const volume::Mesh& m = k < isos ? l.isosurfaces[k] : l.slices[k - isos];
+      if (l.spec.visible) figures_.input_triangles += m.triangle_count();
+      if (!fresh && !l.changed[k]) continue;
+      l.changed[k] = false;
+      if (fresh && !l.spec.visible) continue;
+      const std::uint32_t kind = k < isos ? 0 : 1;
+      ids.push_back(static_cast<std::uint32_t>(v << 16 | kind << 15 | (k < isos ? k : k - isos)));
+      inputs.push_back(l.spec.visible ? mrbsp::SurfaceInput{m.vertices, m.colors, m.triangles} : mrbsp::SurfaceInput{});
+    }
+  }
   const auto t0 = Clock::now();
-  const mrbsp::MergeStats stats = scene.merge(all.vertices, all.colors, all.triangles);
+  if (fresh || !ids.empty()) figures_.tree_triangles = scene.set_surfaces(ids, inputs).stored_polygons;
   figures_.merge_ms = ms_since(t0);
-  figures_.input_triangles = all.triangle_count();
-  figures_.tree_triangles = stats.stored_polygons;
+  figures_.merged_surfaces = ids.size();
+  merged_tree_ = &scene.tree();
 }
 
 void VolumeLayer::set_visible(std::size_t volume, bool visible) {
   spec(volume);
-  volumes_[volume]->spec.visible = visible;
+  Loaded& v = *volumes_[volume];
+  if (v.spec.visible != visible) v.changed.assign(v.changed.size(), true);
+  v.spec.visible = visible;
 }
 
 void VolumeLayer::set_slice(std::size_t volume, std::size_t slice, const volume::SliceSpec& s) {
@@ -140,6 +164,7 @@ void VolumeLayer::set_slice(std::size_t volume, std::size_t slice, const volume:
   const auto t0 = Clock::now();
   v.slices[slice] = v.slice_mesh(s);
   v.spec.slices[slice] = s;
+  v.changed[v.isosurfaces.size() + slice] = true;
   figures_.geometry_ms = ms_since(t0);
 }
 
@@ -152,6 +177,7 @@ void VolumeLayer::set_isosurface(std::size_t volume, std::size_t iso, const volu
   const auto t0 = Clock::now();
   v.isosurfaces[iso] = v.iso_mesh(s);
   v.spec.isosurfaces[iso] = s;
+  v.changed[iso] = true;
   figures_.geometry_ms = ms_since(t0);
 }
 

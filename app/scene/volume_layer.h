@@ -1,8 +1,8 @@
 // The RF volumes of a scene as drawn: each volume read once and placed in the scene frame, the
-// geometry of its isosurfaces and slices (volume/geometry.h), and the merge of all visible
-// geometry into the terrain's tree (Wiley et al. 1997, section 4.2). Interactive changes
-// re-extract only the geometry that changed; the merge itself is always of everything visible,
-// since TerrainTree::merge replaces what was merged before.
+// geometry of its isosurfaces and slices (volume/geometry.h, volume/reduction.h), and their
+// merge into the terrain's tree (Wiley et al. 1997, section 4.2), each isosurface and slice
+// under its own id. Interactive changes re-extract the one surface that changed, and the
+// next merge_into() re-merges that surface alone (TerrainTree::set_surfaces).
 #pragma once
 
 #include <cstddef>
@@ -21,9 +21,11 @@ namespace terravol::app::scene {
 
 // What merging the volumes cost: the geometry (extraction) and the tree's merge.
 struct MergeFigures {
-  std::size_t input_triangles = 0;  // isosurfaces and slices as extracted
-  std::size_t tree_triangles = 0;   // after splitting by the tree's planes, all LOD copies
-  double geometry_ms = 0, merge_ms = 0;
+  std::size_t input_triangles = 0;  // the visible isosurfaces and slices as extracted
+  std::size_t tree_triangles = 0;   // pieces stored in the tree, all LOD copies
+  std::size_t merged_surfaces = 0;  // of the last merge_into(): surfaces (re-)merged
+  double geometry_ms = 0;           // of the last extraction (all, or the one surface changed)
+  double merge_ms = 0;              // of the last merge_into()
 };
 
 // The colour legend of the volumes (the renderer draws it in the lower right): continuous,
@@ -43,8 +45,9 @@ class VolumeLayer {
   // under each from the mosaic (for heights above ground and terrain-following slices) and
   // extracts the geometry of its styles in `frame`. Throws io::FormatError for bad files and
   // std::invalid_argument("FILE: ...") for a volume without a frame or a slice outside it.
-  // Each isosurface and slice is decimated to at most `max_triangles` (volume::decimate; 0:
-  // never), so that merging stays in seconds.
+  // Each isosurface is reduced to at most `max_triangles` (volume::reduced_isosurface with the
+  // default edge collapse; 0: never), so that an isovalue change fits an interaction. Slices
+  // are kept at the volume's resolution (volume::slice), never decimated.
   VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
               std::size_t max_triangles = kDefaultSurfaceTriangles);
   ~VolumeLayer();
@@ -57,11 +60,14 @@ class VolumeLayer {
   // The geometry of every visible volume (isosurfaces, then slices, volume by volume), in the
   // scene frame with per-vertex RGBA: what merge_into() merges.
   volume::Mesh visible_mesh() const;
-  // Merges the geometry of every visible volume into the scene's tree.
+  // Brings the scene's tree up to the volumes: into a tree it has not merged into before,
+  // every visible surface; else only the surfaces changed (set_*) since the last call (a
+  // hidden volume's surfaces are removed). Ids: volume << 16 | 0 (isosurface) or 1 (slice)
+  // << 15 | index.
   void merge_into(TerrainScene& scene);
   const MergeFigures& figures() const { return figures_; }
 
-  // Interactive changes: re-extract the one piece of geometry (call merge_into() after).
+  // Interactive changes: re-extract the one surface (call merge_into() after).
   // Throw std::invalid_argument for indices out of range and slices outside the volume.
   void set_visible(std::size_t volume, bool visible);
   void set_slice(std::size_t volume, std::size_t slice, const volume::SliceSpec& spec);
@@ -75,6 +81,7 @@ class VolumeLayer {
   struct Loaded;
   std::vector<std::unique_ptr<Loaded>> volumes_;
   MergeFigures figures_;
+  const void* merged_tree_ = nullptr;  // the tree merge_into() last brought up to date
   std::size_t max_triangles_ = kDefaultSurfaceTriangles;
 };
 
