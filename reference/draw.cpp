@@ -67,14 +67,15 @@ void unlit(vtkPolyDataMapper& mapper, vtkActor& actor) {
   p->BackfaceCullingOff();
 }
 
-// VTK 9.1 on Debian renders through GLX only and aborts without a display: fail first.
-void require_display() {
-  Display* d = XOpenDisplay(nullptr);
-  if (d == nullptr) throw std::runtime_error("reference: cannot open an X display (set DISPLAY, or run under xvfb-run)");
-  XCloseDisplay(d);
-}
-
 }  // namespace
+
+void require_display() {
+  // Kept open for the life of the process: Xvfb resets when its last client leaves and refuses
+  // connections while it does, which a render run as a child process between two of ours
+  // would otherwise trigger ("bad X server connection", and VTK aborts).
+  static Display* const kept = XOpenDisplay(nullptr);
+  if (kept == nullptr) throw std::runtime_error("reference: cannot open an X display (set DISPLAY, or run under xvfb-run)");
+}
 
 Drawn read_drawn(const std::filesystem::path& vtp) {
   if (!std::filesystem::exists(vtp)) fail(vtp, "no such file");

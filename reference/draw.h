@@ -38,6 +38,12 @@ struct Image {
   std::vector<std::uint8_t> rgb;
 };
 
+// Throws std::runtime_error when no X display can be opened (VTK 9.1 on Debian renders through
+// GLX only, and aborts without one). The first successful call keeps its connection open until
+// the process ends, so that an Xvfb server does not reset (refusing connections meanwhile) when
+// another client, e.g. a render run by run_render, leaves; call it before such runs.
+void require_display();
+
 // Draws `drawn.terrain` opaque (colours as they are, lighting off, depth-tested) and `volumes`
 // translucent (both faces, lighting off) with vtkRenderer's depth peeling: no limit on peels
 // (INT_MAX, not 0: VTK 9.1's dual depth peeling takes 0 literally and peels nothing),
