@@ -30,7 +30,8 @@ struct BenchOptions {
   std::filesystem::path out = "bench/results";
   std::filesystem::path data;
   std::vector<std::filesystem::path> dems;
-  std::string suites = "terrain,translucency,scaling,build";
+  std::filesystem::path under_test;
+  std::string suites = "terrain,translucency,scaling,build,exactness";
   int views = 0, repeats = 0;
 };
 
@@ -82,13 +83,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build)");
+                               "' (terrain, translucency, scaling, build, exactness)");
     }
     out.insert(s);
   }
@@ -113,6 +114,9 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   c.volume_views = o.quick ? 3 : 8;
   c.repeats = o.quick ? 2 : 3;
   c.plain_largest = !o.quick;
+  c.quick = o.quick;
+  c.out = o.out;
+  c.under_test = o.under_test;
   if (o.views) c.views = o.views;
   if (o.repeats) {
     c.repeats = o.repeats;
@@ -160,6 +164,14 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   if (suites.count("translucency"))
     for (std::size_t k = 0; k < transmitters.size(); ++k)
       results["translucency"].push_back(translucency_suite(c, real[k], transmitters[k]));
+  if (suites.count("exactness"))
+    for (const Terrain& t : real) {
+      if (has_exactness_scene(t.name)) {
+        results["exactness"].push_back(exactness_suite(c, t));
+      } else {
+        c.log("exactness: no scene for " + t.name + " (only the shared N44W072 and Utah terrains have one)");
+      }
+    }
   if (suites.count("scaling")) {
     // One tile, the six Utah tiles when there, and 16 tiles of the project's own generator.
     const auto tiles = c.cache / "tiles";
@@ -196,7 +208,10 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness")->capture_default_str();
+  cmd->add_option("--under-test", o->under_test,
+                  "The terravol executable whose render the exactness suite measures (default: this one)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--views", o->views, "Views of each terrain flythrough (default 60, quick 12)")->check(CLI::Range(1, 10000));
   cmd->add_option("--repeats", o->repeats, "Timed repetitions per frame (default 3, quick 2)")->check(CLI::Range(1, 100));
   cmd->callback([o] {
@@ -206,6 +221,7 @@ void add_bench_command(CLI::App& app) {
     if (o->views) command += " --views " + std::to_string(o->views);
     if (o->repeats) command += " --repeats " + std::to_string(o->repeats);
     for (const auto& d : o->dems) command += " --dem " + d.string();
+    if (!o->under_test.empty()) command += " --under-test " + o->under_test.string();
     run_bench(*o, command);
   });
 }

@@ -45,6 +45,18 @@ std::vector<View> orbit(double lat, double lon, double range_km, double agl, dou
   return views;
 }
 
+void rf_volume(const Terrain& terrain, const volume::Transmitter& transmitter, double radius_km, double top_m,
+               double step_m, const std::filesystem::path& file, const std::function<void(const std::string&)>& progress) {
+  if (std::filesystem::exists(file)) return;
+  if (progress) progress("computing " + file.string());
+  const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
+  volume::RfGrid grid;
+  grid.radius_km = radius_km;
+  for (double h = 0; h <= top_m + 1e-9; h += step_m) grid.heights_agl.push_back(h);
+  const volume::RfResult r = volume::compute_rf(mosaic, transmitter, grid);
+  volume::write_vdb(file, {&r.path_loss}, false);
+}
+
 VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters,
                                const std::filesystem::path& cache,
                                const std::function<void(const std::string&)>& progress) {
@@ -55,15 +67,7 @@ VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume:
   const double iso[3][2][2] = {{{105, 0.4}, {125, 0.3}}, {{110, 0.6}, {120, 0.35}}, {{100, 0.5}, {115, 0.45}}};
   for (std::size_t k = 0; k < transmitters.size(); ++k) {
     const auto file = cache / (terrain.name + "-rf" + std::to_string(k) + ".vdb");
-    if (!std::filesystem::exists(file)) {
-      if (progress) progress("computing " + file.string());
-      const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
-      volume::RfGrid grid;
-      grid.radius_km = 12.0;
-      for (double h = 0; h <= 2000.0; h += 100.0) grid.heights_agl.push_back(h);
-      const volume::RfResult r = volume::compute_rf(mosaic, transmitters[k], grid);
-      volume::write_vdb(file, {&r.path_loss}, false);
-    }
+    rf_volume(terrain, transmitters[k], 12.0, 2000.0, 100.0, file, progress);
     app::scene::VolumeSpec v;
     v.file = file;
     for (const auto& [value, opacity] : iso[k % 3]) {

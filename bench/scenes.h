@@ -36,6 +36,13 @@ std::vector<View> flythrough(const app::scene::WindowBounds& bounds, int count);
 // looking at the centre with pitch `pitch_deg`, starting from the south-west.
 std::vector<View> orbit(double lat, double lon, double range_km, double agl, double pitch_deg, int count);
 
+// `file`, an RF path-loss volume of the transmitter over the terrain by the built-in model (as
+// `terravol rf --radius-km R --heights 0:TOP:STEP` writes it), computed and written unless it is
+// already there. `progress` is told when it is computed. Throws what compute_rf and write_vdb
+// throw.
+void rf_volume(const Terrain& terrain, const volume::Transmitter& transmitter, double radius_km, double top_m,
+               double step_m, const std::filesystem::path& file, const std::function<void(const std::string&)>& progress);
+
 // The three-volume scene of scripts/exactness.sh over a terrain: an RF path-loss volume per
 // transmitter
 // (three expected; 12 km radius, 0-2000 m, written as `<cache>/<name>-rfK.vdb` by the built-in model unless

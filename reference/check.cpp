@@ -110,6 +110,9 @@ RenderStats read_stats(const fs::path& stats) {
     s.height = j.at("height").get<int>();
     s.origin_lat = j.at("window").at("origin_lat").get<double>();
     s.origin_lon = j.at("window").at("origin_lon").get<double>();
+    const auto& w = j.at("window");
+    s.window = {w.at("cells").get<int>(), w.at("south").get<double>(), w.at("north").get<double>(),
+                w.at("west").get<double>(), w.at("east").get<double>()};
     return s;
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(stats.string() + ": " + e.what());
@@ -156,6 +159,7 @@ Reference reference_image(const fs::path& scene_file, const fs::path& vtp, const
   }
   r.volume_triangles = all.triangle_count();
   r.drawn = read_drawn(vtp);
+  texture_terrain(r.drawn, frame, stats.window);
   r.geometry_ms = ms_since(t0);
   const auto t1 = Clock::now();
   r.image = draw(r.drawn, all, stats.width, stats.height);

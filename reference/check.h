@@ -5,10 +5,11 @@
 // --surface-triangles 0 --haze 0 --export-vtp drawn.vtp --stats stats.json -o ours.png`. Its
 // image is then compared with one built without the tree, the volume layer or the renderer
 // (reference_image):
-// - terrain: the exported triangles whose level is >= -1 (terrain and crack fills) with their
-//   per-vertex colours, opaque and depth-tested. At --full-res the vertices are the lattice
-//   samples; the renderer samples the same colours from a bilinear texture, which differs
-//   slightly inside each cell (measured: see docs/architecture.md, "The independent reference");
+// - terrain: the exported triangles whose level is >= -1 (terrain and crack fills), opaque and
+//   depth-tested, their exported colours sampled as the renderer samples them: from a bilinear
+//   texture of the lattice (draw.h, texture_terrain; at --full-res the vertices are the lattice
+//   samples). Gouraud-interpolated vertex colours would differ inside each cell, by more than
+//   8/255 on 0.16% of one view's pixels over rough terrain, more than the target allows;
 // - volumes: each visible volume of the scene file read again (volume::read_volume: reading is
 //   not under test), its isosurfaces extracted again and its slices cut again
 //   (reference/geometry.h), placed by this folder's own scene frame (reference/frame.h) with
@@ -31,6 +32,7 @@ namespace terravol::reference {
 struct RenderStats {
   int width = 0, height = 0;
   double origin_lat = 0, origin_lon = 0;  // the scene frame's origin (window.origin_*)
+  WindowLattice window;                   // window.cells, south, north, west, east
 };
 // Throws std::runtime_error("PATH: ...") when unreadable or a key is missing.
 RenderStats read_stats(const std::filesystem::path& stats);

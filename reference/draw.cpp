@@ -6,11 +6,15 @@
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkDepthPeelingPass.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
+#include <vtkFloatArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOpenGLRenderer.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -18,9 +22,12 @@
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkTexture.h>
+#include <vtkTranslucentPass.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -50,6 +57,37 @@ std::optional<std::array<std::uint8_t, 3>> rgb_field(vtkFieldData* fd, const cha
   for (int k = 0; k < 3; ++k) c[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(a->GetComponent(0, k));
   return c;
 }
+
+// A renderer that peels with vtkDepthPeelingPass (one layer a peel) where vtkOpenGLRenderer
+// would choose vtkDualDepthPeelingPass. VTK 9.1's dual peeling is not exact over opaque
+// geometry: where an opaque surface lies behind the translucent layers of a pixel, that pixel's
+// back peel is the opaque depth and stays empty, so its layers come off the front one a peel;
+// but peeling stops when no pixel's back peel writes anything (the occlusion query wraps the
+// back blend only), and the layers left are then dropped, not even blended unsorted (the
+// mop-up runs only when pixels were written). Over terrain that happens as soon as the
+// translucent pixels seen against the sky run out of layers (tests/reference/draw_test.cpp
+// shows it: twelve layers over an opaque square composite as one). The single-layer pass counts
+// the fragments of every peel and stops only when a peel finds none. vtkOpenGLRenderer creates
+// its peeling pass only when it has none, so setting one here is enough.
+class SingleLayerPeelingRenderer : public vtkOpenGLRenderer {
+ public:
+  static SingleLayerPeelingRenderer* New();
+  vtkTypeMacro(SingleLayerPeelingRenderer, vtkOpenGLRenderer);
+
+ protected:
+  SingleLayerPeelingRenderer() {
+    vtkDepthPeelingPass* peeling = vtkDepthPeelingPass::New();  // owned by vtkOpenGLRenderer
+    vtkNew<vtkTranslucentPass> translucent;
+    peeling->SetTranslucentPass(translucent);
+    this->DepthPeelingPass = peeling;
+  }
+  ~SingleLayerPeelingRenderer() override = default;
+
+ private:
+  SingleLayerPeelingRenderer(const SingleLayerPeelingRenderer&) = delete;
+  void operator=(const SingleLayerPeelingRenderer&) = delete;
+};
+vtkStandardNewMacro(SingleLayerPeelingRenderer);
 
 // Colours as given: direct RGBA scalars, no lighting, both faces.
 void unlit(vtkPolyDataMapper& mapper, vtkActor& actor) {
@@ -121,10 +159,77 @@ Drawn read_drawn(const std::filesystem::path& vtp) {
   return d;
 }
 
+void texture_terrain(Drawn& drawn, const Frame& frame, const WindowLattice& w) {
+  if (w.cells < 1) throw std::runtime_error("reference: a window of " + std::to_string(w.cells) + " cells");
+  const int side = w.cells + 1;
+  const double dlat = (w.north - w.south) / w.cells, dlon = (w.east - w.west) / w.cells;
+  vtkPoints* points = drawn.terrain->GetPoints();
+  vtkDataArray* rgba = drawn.terrain->GetPointData()->GetScalars();
+  const vtkIdType n = points->GetNumberOfPoints();
+  std::vector<int> lattice(static_cast<std::size_t>(n), -1);  // row * side + column
+  auto place = [&](vtkIdType p) {
+    int& at = lattice[static_cast<std::size_t>(p)];
+    if (at >= 0) return at;
+    double xyz[3];
+    points->GetPoint(p, xyz);
+    const double fc = (frame.lon_of(xyz[0]) - w.west) / dlon, fr = (frame.lat_of(xyz[1]) - w.south) / dlat;
+    const double c = std::round(fc), r = std::round(fr);
+    if (std::abs(fc - c) > 0.01 || std::abs(fr - r) > 0.01 || c < 0 || r < 0 || c >= side || r >= side) {
+      throw std::runtime_error("reference: an exported terrain point lies off the window's lattice lines "
+                               "(column " + std::to_string(fc) + ", row " + std::to_string(fr) + ")");
+    }
+    at = static_cast<int>(r) * side + static_cast<int>(c);
+    return at;
+  };
+  vtkNew<vtkUnsignedCharArray> texels;
+  texels->SetNumberOfComponents(4);
+  texels->SetNumberOfTuples(static_cast<vtkIdType>(side) * side);
+  texels->Fill(0);
+  vtkCellArray* polys = drawn.terrain->GetPolys();
+  vtkNew<vtkIdList> cell;
+  for (vtkIdType t = 0; t < polys->GetNumberOfCells(); ++t) {
+    polys->GetCellAtId(t, cell);
+    int lo_c = side, hi_c = -1, lo_r = side, hi_r = -1;
+    for (vtkIdType k = 0; k < cell->GetNumberOfIds(); ++k) {
+      const int at = place(cell->GetId(k));
+      lo_c = std::min(lo_c, at % side), hi_c = std::max(hi_c, at % side);
+      lo_r = std::min(lo_r, at / side), hi_r = std::max(hi_r, at / side);
+    }
+    if (hi_c - lo_c > 1 || hi_r - lo_r > 1) {
+      throw std::runtime_error("reference: an exported terrain triangle spans more than one lattice cell "
+                               "(render with --full-res)");
+    }
+  }
+  std::vector<bool> filled(static_cast<std::size_t>(side) * side, false);
+  vtkNew<vtkFloatArray> tcoords;
+  tcoords->SetName("tcoords");
+  tcoords->SetNumberOfComponents(2);
+  tcoords->SetNumberOfTuples(n);
+  for (vtkIdType p = 0; p < n; ++p) {
+    const int at = lattice[static_cast<std::size_t>(p)];
+    if (at < 0) {  // a point no terrain triangle uses
+      tcoords->SetTuple2(p, 0.0, 0.0);
+      continue;
+    }
+    const int c = at % side, r = at / side;
+    tcoords->SetTuple2(p, (c + 0.5f) / static_cast<float>(side), (r + 0.5f) / static_cast<float>(side));
+    if (!filled[static_cast<std::size_t>(at)]) {  // the first point of a sample gives its colour
+      filled[static_cast<std::size_t>(at)] = true;
+      double v[4];
+      rgba->GetTuple(p, v);
+      for (int k = 0; k < 4; ++k) texels->SetComponent(at, k, v[k]);
+    }
+  }
+  drawn.terrain->GetPointData()->SetTCoords(tcoords);
+  drawn.texture = vtkSmartPointer<vtkImageData>::New();
+  drawn.texture->SetDimensions(side, side, 1);
+  drawn.texture->GetPointData()->SetScalars(texels);
+}
+
 Image draw(const Drawn& drawn, const Mesh& volumes, int width, int height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("reference: empty image size");
   require_display();
-  vtkNew<vtkRenderer> renderer;
+  vtkNew<SingleLayerPeelingRenderer> renderer;
   vtkNew<vtkRenderWindow> window;
 
   vtkNew<vtkPolyDataMapper> terrain_mapper;
@@ -132,6 +237,17 @@ Image draw(const Drawn& drawn, const Mesh& volumes, int width, int height) {
   terrain_mapper->SetInputData(drawn.terrain);
   unlit(*terrain_mapper, *terrain_actor);
   terrain_actor->ForceOpaqueOn();
+  vtkNew<vtkTexture> texture;
+  if (drawn.texture) {
+    texture->SetInputData(drawn.texture);
+    texture->InterpolateOn();
+    texture->MipmapOff();
+    texture->EdgeClampOn();
+    texture->RepeatOff();
+    texture->SetColorModeToDirectScalars();
+    terrain_actor->SetTexture(texture);
+    terrain_mapper->ScalarVisibilityOff();  // the texture alone, not texture times vertex colour
+  }
   renderer->AddActor(terrain_actor);
 
   vtkNew<vtkPolyData> overlay;

@@ -35,4 +35,13 @@ glm::dvec3 Frame::to_scene(double lat, double lon, double h) const {
   return {x, y, h - (x * x + y * y) / (2.0 * radius_)};
 }
 
+double Frame::lat_of(double y) const { return lat0_ + y / north_per_radian_ / kRadiansPerDegree; }
+
+double Frame::lon_of(double x) const {
+  double lon = std::fmod(lon0_ + x / east_per_radian_ / kRadiansPerDegree, 360.0);
+  if (lon < -180.0) lon += 360.0;
+  if (lon >= 180.0) lon -= 360.0;
+  return lon;
+}
+
 }  // namespace terravol::reference

@@ -19,6 +19,10 @@ class Frame {
 
   // lat, lon in degrees; h metres in the DEM's vertical datum. Returns scene metres.
   glm::dvec3 to_scene(double lat, double lon, double h) const;
+  // The inverse for the horizontal axes: the latitude of y and the longitude (in [-180, 180)) of
+  // x, degrees.
+  double lat_of(double y) const;
+  double lon_of(double x) const;
 
   double lat0() const { return lat0_; }
   double lon0() const { return lon0_; }
