@@ -97,15 +97,6 @@ std::set<std::string> parse_suites(const std::string& list) {
   return out;
 }
 
-// A 900 MHz transmitter without ERP (path loss only), as scripts/exactness.sh makes them.
-volume::Transmitter tx(double lat, double lon, double height_agl) {
-  volume::Transmitter t;
-  t.lat = lat;
-  t.lon = lon;
-  t.height_agl = height_agl;
-  return t;
-}
-
 void run_bench(const BenchOptions& o, const std::string& command) {
   const std::set<std::string> suites = parse_suites(o.suites);
   const auto t0 = Clock::now();
@@ -141,9 +132,10 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     real.push_back({o.dems.front().stem().string(), o.dems, static_cast<int>(o.dems.size())});
   } else if (std::filesystem::is_directory(data / "dem")) {
     real.push_back({"n44w072", {data / "dem" / "N44W072.hgt"}, 1});
-    transmitters.push_back({tx(44.27, -71.30, 30), tx(44.32, -71.22, 60), tx(44.22, -71.20, 20)});
+    transmitters.push_back({transmitter(44.27, -71.30, 30), transmitter(44.32, -71.22, 60), transmitter(44.22, -71.20, 20)});
     real.push_back({"utah", {data / "dem" / "utah_sdf"}, 6});
-    transmitters.push_back({tx(40.6589, -112.2019, 30), tx(40.76, -111.89, 30), tx(40.60, -111.80, 40)});
+    transmitters.push_back(
+        {transmitter(40.6589, -112.2019, 30), transmitter(40.76, -111.89, 30), transmitter(40.60, -111.80, 40)});
   } else {
     c.log(data.string() + "/dem not found: the terrain, translucency and build suites are skipped "
           "(give --data or --dem)");

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "bench/scenes.h"
 #include "bench/stats.h"
 #include "bench/suites.h"
 #include "reference/check.h"
@@ -42,15 +43,6 @@ NamedView view(const char* name, double lat, double lon, double alt, double head
   v.pose.pitch_deg = pitch;
   v.agl = agl;
   return v;
-}
-
-volume::Transmitter transmitter(double lat, double lon, double height_agl) {
-  volume::Transmitter t;
-  t.lat = lat;
-  t.lon = lon;
-  t.height_agl = height_agl;
-  t.frequency_mhz = 900.0;
-  return t;
 }
 
 std::optional<ExactnessScene> scene_of(const std::string& terrain) {

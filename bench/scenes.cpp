@@ -45,6 +45,15 @@ std::vector<View> orbit(double lat, double lon, double range_km, double agl, dou
   return views;
 }
 
+volume::Transmitter transmitter(double lat, double lon, double height_agl) {
+  volume::Transmitter t;
+  t.lat = lat;
+  t.lon = lon;
+  t.height_agl = height_agl;
+  t.frequency_mhz = 900.0;
+  return t;
+}
+
 void rf_volume(const Terrain& terrain, const volume::Transmitter& transmitter, double radius_km, double top_m,
                double step_m, const std::filesystem::path& file, const std::function<void(const std::string&)>& progress) {
   if (std::filesystem::exists(file)) return;

@@ -36,6 +36,9 @@ std::vector<View> flythrough(const app::scene::WindowBounds& bounds, int count);
 // looking at the centre with pitch `pitch_deg`, starting from the south-west.
 std::vector<View> orbit(double lat, double lon, double range_km, double agl, double pitch_deg, int count);
 
+// A 900 MHz transmitter without ERP (path loss only), as scripts/exactness.sh makes them.
+volume::Transmitter transmitter(double lat, double lon, double height_agl);
+
 // `file`, an RF path-loss volume of the transmitter over the terrain by the built-in model (as
 // `terravol rf --radius-km R --heights 0:TOP:STEP` writes it), computed and written unless it is
 // already there. `progress` is told when it is computed. Throws what compute_rf and write_vdb
