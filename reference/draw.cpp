@@ -200,7 +200,9 @@ void texture_terrain(Drawn& drawn, const Frame& frame, const WindowLattice& w) {
                                "(render with --full-res)");
     }
   }
-  std::vector<bool> filled(static_cast<std::size_t>(side) * side, false);
+  // A sample's colour from its own point, the highest of those on its lattice line (crack-fill
+  // bottoms hang below it).
+  std::vector<double> top(static_cast<std::size_t>(side) * side, -std::numeric_limits<double>::infinity());
   vtkNew<vtkFloatArray> tcoords;
   tcoords->SetName("tcoords");
   tcoords->SetNumberOfComponents(2);
@@ -213,8 +215,10 @@ void texture_terrain(Drawn& drawn, const Frame& frame, const WindowLattice& w) {
     }
     const int c = at % side, r = at / side;
     tcoords->SetTuple2(p, (c + 0.5f) / static_cast<float>(side), (r + 0.5f) / static_cast<float>(side));
-    if (!filled[static_cast<std::size_t>(at)]) {  // the first point of a sample gives its colour
-      filled[static_cast<std::size_t>(at)] = true;
+    double xyz[3];
+    points->GetPoint(p, xyz);
+    if (xyz[2] > top[static_cast<std::size_t>(at)]) {
+      top[static_cast<std::size_t>(at)] = xyz[2];
       double v[4];
       rgba->GetTuple(p, v);
       for (int k = 0; k < 4; ++k) texels->SetComponent(at, k, v[k]);

@@ -57,8 +57,9 @@ struct WindowLattice {
 // cell, by more than 8/255 on a few tenths of a percent of the pixels of rough terrain near
 // the camera, which would hide what the check is for; so the texture is built here from the
 // exported colours: each exported terrain point is placed on the lattice (its lattice line from
-// x and y through the frame's inverse; crack-fill bottoms take their sample's, as in the
-// renderer) and gives its texel its colour. Needs a --full-res render. Throws
+// x and y through the frame's inverse) and the highest point of each line, the sample itself,
+// gives its texel its colour (crack-fill bottoms below it sample the same texel, as in the
+// renderer). Needs a --full-res render. Throws
 // std::runtime_error when a point is off the lattice lines or a triangle spans more than one
 // cell (not --full-res).
 void texture_terrain(Drawn& drawn, const Frame& frame, const WindowLattice& window);
