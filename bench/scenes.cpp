@@ -1,8 +1,10 @@
 #include "bench/scenes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include "app/scene/mosaic_lattice.h"
 #include "io/mosaic.h"
 #include "volume/vdb_write.h"
 
@@ -45,6 +47,25 @@ std::vector<View> orbit(double lat, double lon, double range_km, double agl, dou
   return views;
 }
 
+double volume_orbit_km(const app::scene::WindowBounds& b, double lat) {
+  const double half_km = 0.5 * std::min((b.north - b.south) * 111.32,
+                                        (b.east - b.west) * 111.32 * std::cos(lat * std::numbers::pi / 180.0));
+  return std::min(8.0, 0.4 * half_km);
+}
+
+app::scene::WindowBounds centred_window(const Terrain& terrain, double lat, double lon, int max_cells) {
+  const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
+  const app::scene::LatticePoint p = app::scene::lattice_point(mosaic, lat, lon);
+  const app::scene::WindowChoice w = app::scene::choose_window(mosaic.rows(), mosaic.cols(), p.row, p.col, max_cells);
+  const io::Georef& g = mosaic.georef();
+  app::scene::WindowBounds b;
+  b.north = g.y0 - w.row0 * g.dy;
+  b.south = b.north - w.cells * g.dy;
+  b.west = g.x0 + w.col0 * g.dx;
+  b.east = b.west + w.cells * g.dx;
+  return b;
+}
+
 volume::Transmitter transmitter(double lat, double lon, double height_agl) {
   volume::Transmitter t;
   t.lat = lat;
@@ -52,6 +73,13 @@ volume::Transmitter transmitter(double lat, double lon, double height_agl) {
   t.height_agl = height_agl;
   t.frequency_mhz = 900.0;
   return t;
+}
+
+std::vector<volume::Transmitter> benchmark_transmitters(const std::string& terrain) {
+  if (terrain == "n44w072") return {transmitter(44.27, -71.30, 30), transmitter(44.32, -71.22, 60), transmitter(44.22, -71.20, 20)};
+  if (terrain == "utah")
+    return {transmitter(40.6589, -112.2019, 30), transmitter(40.76, -111.89, 30), transmitter(40.60, -111.80, 40)};
+  return {};
 }
 
 void rf_volume(const Terrain& terrain, const volume::Transmitter& transmitter, double radius_km, double top_m,
