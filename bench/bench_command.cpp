@@ -4,6 +4,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -30,7 +31,9 @@ struct BenchOptions {
   std::filesystem::path out = "bench/results";
   std::filesystem::path data;
   std::vector<std::filesystem::path> dems;
-  std::string suites = "terrain,translucency,scaling,build";
+  std::filesystem::path under_test;
+  std::string exactness_views;
+  std::string suites = "terrain,translucency,scaling,build,exactness";
   int views = 0, repeats = 0;
 };
 
@@ -82,27 +85,18 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build)");
+                               "' (terrain, translucency, scaling, build, exactness)");
     }
     out.insert(s);
   }
   if (out.empty()) throw std::runtime_error("--suites: empty list");
   return out;
-}
-
-// A 900 MHz transmitter without ERP (path loss only), as scripts/exactness.sh makes them.
-volume::Transmitter tx(double lat, double lon, double height_agl) {
-  volume::Transmitter t;
-  t.lat = lat;
-  t.lon = lon;
-  t.height_agl = height_agl;
-  return t;
 }
 
 void run_bench(const BenchOptions& o, const std::string& command) {
@@ -113,6 +107,10 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   c.volume_views = o.quick ? 3 : 8;
   c.repeats = o.quick ? 2 : 3;
   c.plain_largest = !o.quick;
+  c.quick = o.quick;
+  c.out = o.out;
+  c.under_test = o.under_test;
+  c.exactness_views = o.exactness_views;
   if (o.views) c.views = o.views;
   if (o.repeats) {
     c.repeats = o.repeats;
@@ -137,9 +135,9 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     real.push_back({o.dems.front().stem().string(), o.dems, static_cast<int>(o.dems.size())});
   } else if (std::filesystem::is_directory(data / "dem")) {
     real.push_back({"n44w072", {data / "dem" / "N44W072.hgt"}, 1});
-    transmitters.push_back({tx(44.27, -71.30, 30), tx(44.32, -71.22, 60), tx(44.22, -71.20, 20)});
+    transmitters.push_back(benchmark_transmitters("n44w072"));
     real.push_back({"utah", {data / "dem" / "utah_sdf"}, 6});
-    transmitters.push_back({tx(40.6589, -112.2019, 30), tx(40.76, -111.89, 30), tx(40.60, -111.80, 40)});
+    transmitters.push_back(benchmark_transmitters("utah"));
   } else {
     c.log(data.string() + "/dem not found: the terrain, translucency and build suites are skipped "
           "(give --data or --dem)");
@@ -153,6 +151,23 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   results["height"] = c.height;
   results["repeats"] = c.repeats;
   results["machine"] = machine();
+  std::vector<const Terrain*> exact;  // the terrains the exactness suite draws
+  if (suites.count("exactness")) {
+    std::set<std::string> unknown;
+    std::stringstream in(c.exactness_views);
+    for (std::string n; std::getline(in, n, ',');)
+      if (!n.empty()) unknown.insert(n);
+    for (const Terrain& t : real) {
+      const std::vector<std::string> names = exactness_views(c, t.name);
+      for (const std::string& n : names) {
+        unknown.erase(n);
+        unknown.erase(t.name + "-" + n);
+      }
+      if (!names.empty()) exact.push_back(&t);
+    }
+    if (!unknown.empty())
+      throw std::runtime_error("--exactness-views: no view '" + *unknown.begin() + "' on these terrains");
+  }
   if (suites.count("build"))
     for (const Terrain& t : real) results["build"].push_back(build_suite(c, t));
   if (suites.count("terrain"))
@@ -160,6 +175,16 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   if (suites.count("translucency"))
     for (std::size_t k = 0; k < transmitters.size(); ++k)
       results["translucency"].push_back(translucency_suite(c, real[k], transmitters[k]));
+  if (suites.count("exactness"))
+    for (const Terrain& t : real) {
+      if (std::find(exact.begin(), exact.end(), &t) != exact.end()) {
+        results["exactness"].push_back(exactness_suite(c, t));
+      } else if (has_exactness_scene(t.name)) {
+        c.log("exactness: no view selected on " + t.name);
+      } else {
+        c.log("exactness: no scene for " + t.name + " (only the shared N44W072 and Utah terrains have one)");
+      }
+    }
   if (suites.count("scaling")) {
     // One tile, the six Utah tiles when there, and 16 tiles of the project's own generator.
     const auto tiles = c.cache / "tiles";
@@ -196,7 +221,12 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness")->capture_default_str();
+  cmd->add_option("--under-test", o->under_test,
+                  "The terravol executable whose render the exactness suite measures (default: this one)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--exactness-views", o->exactness_views,
+                  "Exactness: only these views, comma-separated VIEW or TERRAIN-VIEW (e.g. n44w072-inside)");
   cmd->add_option("--views", o->views, "Views of each terrain flythrough (default 60, quick 12)")->check(CLI::Range(1, 10000));
   cmd->add_option("--repeats", o->repeats, "Timed repetitions per frame (default 3, quick 2)")->check(CLI::Range(1, 100));
   cmd->callback([o] {
@@ -206,6 +236,8 @@ void add_bench_command(CLI::App& app) {
     if (o->views) command += " --views " + std::to_string(o->views);
     if (o->repeats) command += " --repeats " + std::to_string(o->repeats);
     for (const auto& d : o->dems) command += " --dem " + d.string();
+    if (!o->under_test.empty()) command += " --under-test " + o->under_test.string();
+    if (!o->exactness_views.empty()) command += " --exactness-views " + o->exactness_views;
     run_bench(*o, command);
   });
 }

@@ -11,7 +11,7 @@ namespace terravol::bench {
 
 // Writes `dir`/report.md and its plots (`dir`/plot-*.png, linked by file name) from `results`:
 // {"machine": {...}, "date": ..., "quick": bool, "terrain": [...], "translucency": [...],
-// "scaling": [...], "build": [...]}; absent suites are left out. Throws std::runtime_error when a
+// "scaling": [...], "build": [...], "exactness": [...]}; absent suites are left out. Throws std::runtime_error when a
 // file cannot be written.
 void write_report(const nlohmann::json& results, const std::filesystem::path& dir);
 

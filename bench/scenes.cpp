@@ -1,8 +1,10 @@
 #include "bench/scenes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
+#include "app/scene/mosaic_lattice.h"
 #include "io/mosaic.h"
 #include "volume/vdb_write.h"
 
@@ -45,6 +47,53 @@ std::vector<View> orbit(double lat, double lon, double range_km, double agl, dou
   return views;
 }
 
+double volume_orbit_km(const app::scene::WindowBounds& b, double lat) {
+  const double half_km = 0.5 * std::min((b.north - b.south) * 111.32,
+                                        (b.east - b.west) * 111.32 * std::cos(lat * std::numbers::pi / 180.0));
+  return std::min(8.0, 0.4 * half_km);
+}
+
+app::scene::WindowBounds centred_window(const Terrain& terrain, double lat, double lon, int max_cells) {
+  const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
+  const app::scene::LatticePoint p = app::scene::lattice_point(mosaic, lat, lon);
+  const app::scene::WindowChoice w = app::scene::choose_window(mosaic.rows(), mosaic.cols(), p.row, p.col, max_cells);
+  const io::Georef& g = mosaic.georef();
+  app::scene::WindowBounds b;
+  b.north = g.y0 - w.row0 * g.dy;
+  b.south = b.north - w.cells * g.dy;
+  b.west = g.x0 + w.col0 * g.dx;
+  b.east = b.west + w.cells * g.dx;
+  return b;
+}
+
+volume::Transmitter transmitter(double lat, double lon, double height_agl) {
+  volume::Transmitter t;
+  t.lat = lat;
+  t.lon = lon;
+  t.height_agl = height_agl;
+  t.frequency_mhz = 900.0;
+  return t;
+}
+
+std::vector<volume::Transmitter> benchmark_transmitters(const std::string& terrain) {
+  if (terrain == "n44w072") return {transmitter(44.27, -71.30, 30), transmitter(44.32, -71.22, 60), transmitter(44.22, -71.20, 20)};
+  if (terrain == "utah")
+    return {transmitter(40.6589, -112.2019, 30), transmitter(40.76, -111.89, 30), transmitter(40.60, -111.80, 40)};
+  return {};
+}
+
+void rf_volume(const Terrain& terrain, const volume::Transmitter& transmitter, double radius_km, double top_m,
+               double step_m, const std::filesystem::path& file, const std::function<void(const std::string&)>& progress) {
+  if (std::filesystem::exists(file)) return;
+  if (progress) progress("computing " + file.string());
+  const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
+  volume::RfGrid grid;
+  grid.radius_km = radius_km;
+  for (double h = 0; h <= top_m + 1e-9; h += step_m) grid.heights_agl.push_back(h);
+  const volume::RfResult r = volume::compute_rf(mosaic, transmitter, grid);
+  volume::write_vdb(file, {&r.path_loss}, false);
+}
+
 VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters,
                                const std::filesystem::path& cache,
                                const std::function<void(const std::string&)>& progress) {
@@ -55,15 +104,7 @@ VolumeScene three_volume_scene(const Terrain& terrain, const std::vector<volume:
   const double iso[3][2][2] = {{{105, 0.4}, {125, 0.3}}, {{110, 0.6}, {120, 0.35}}, {{100, 0.5}, {115, 0.45}}};
   for (std::size_t k = 0; k < transmitters.size(); ++k) {
     const auto file = cache / (terrain.name + "-rf" + std::to_string(k) + ".vdb");
-    if (!std::filesystem::exists(file)) {
-      if (progress) progress("computing " + file.string());
-      const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
-      volume::RfGrid grid;
-      grid.radius_km = 12.0;
-      for (double h = 0; h <= 2000.0; h += 100.0) grid.heights_agl.push_back(h);
-      const volume::RfResult r = volume::compute_rf(mosaic, transmitters[k], grid);
-      volume::write_vdb(file, {&r.path_loss}, false);
-    }
+    rf_volume(terrain, transmitters[k], 12.0, 2000.0, 100.0, file, progress);
     app::scene::VolumeSpec v;
     v.file = file;
     for (const auto& [value, opacity] : iso[k % 3]) {

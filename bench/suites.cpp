@@ -214,10 +214,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   auto plain_exact = plain_scene(scene, raw_mesh, Translucency::kPeelExact, c);
 
   // Views around the volumes, within the central half of the window (no slides).
-  const app::scene::WindowBounds b = scene.terrain().bounds();
-  const double half_km = 0.5 * std::min((b.north - b.south) * 111.32,
-                                        (b.east - b.west) * 111.32 * std::cos(vs.lat * 3.14159265358979 / 180.0));
-  const double range_km = std::min(8.0, 0.4 * half_km);
+  const double range_km = volume_orbit_km(scene.terrain().bounds(), vs.lat);
   const std::vector<View> views = orbit(vs.lat, vs.lon, range_km, 2500.0, -22.0, c.volume_views);
   const mrbsp::TraversalOptions lod_default;
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -20,7 +21,11 @@ struct BenchConfig {
   int volume_views = 8;    // views of each translucency orbit (suites 2, 5, 6)
   int repeats = 3;         // timed repetitions of each frame, after one untimed warm-up
   bool plain_largest = true;  // scaling: draw the largest terrain with plain VTK too (33 M triangles)
+  bool quick = false;         // exactness: the issue's two fixed cameras only (plus the orbit)
   std::filesystem::path cache;  // RF volumes and generated tiles, kept between runs
+  std::filesystem::path out;    // the report's folder (exactness keeps its images in exactness/)
+  std::filesystem::path under_test;  // exactness: the terravol whose render is measured; empty: this one
+  std::string exactness_views;       // exactness: comma-separated VIEW or TERRAIN-VIEW; empty: all
   std::function<void(const std::string&)> log;  // progress, one line at a time
 };
 
@@ -48,5 +53,29 @@ nlohmann::json scaling_suite(const BenchConfig& config, const std::vector<Terrai
 // 4. Build and slide of the tree of a 1024-cell window (no rendering): build time, slide time
 // (by one coarsest cell east and back), their ratio, samples per second, bytes per sample.
 nlohmann::json build_suite(const BenchConfig& config, const Terrain& terrain);
+
+// 7. Exactness (issue 11): the real `terravol render --full-res --surface-triangles 0 --haze 0`
+// (run as a child process: `under_test`, or this executable) against the independent reference
+// (reference/check.h: the exported terrain, the volumes extracted again from their files and
+// placed by the reference's own code, VTK depth peeling with no peel limit). Scenes over the
+// terrain: the issue's two 8 km RF volumes (0-1500 m every 100 m, isosurfaces at 110 and 125 dB
+// and at 112 and 122 dB), in render's default window and in a 256-cell one; and the translucency
+// suite's three volumes and slice (three_volume_scene). Views: inside the second volume (the
+// issue's 44.16,-71.40,1800,40,-12 over N44W072), outside (44.05,-71.60,4500,35,-18), beside it,
+// near the ground (beside and inside), far above, two at the edges of the 256-cell window,
+// `volume_views` views of an 8 km orbit at 2500 m (fov 50), and the translucency suite's orbit
+// poses about its three volumes (fov 45; render centres its window on each camera, that suite
+// on the volumes). A uniform background, no legend. Per view: the share of pixels within 8/255
+// (and its complement, over_8) and 3/255 of the reference (issue 11's target: >= 99.9% within
+// 8/255 for every view), of the same render with --order peel within 8/255 of the reference
+// and within 3/255 of bsp (target: >= 99.9%); the images of each view go to out/exactness/.
+// `exactness_views` selects views. Terrains with a scene: "n44w072" and "utah"
+// (has_exactness_scene). Throws for another terrain or no view selected, and what the render and
+// the reference throw.
+bool has_exactness_scene(const std::string& terrain);
+// The names of the views the suite draws over the terrain with this configuration (empty for a
+// terrain without a scene).
+std::vector<std::string> exactness_views(const BenchConfig& config, const std::string& terrain);
+nlohmann::json exactness_suite(const BenchConfig& config, const Terrain& terrain);
 
 }  // namespace terravol::bench

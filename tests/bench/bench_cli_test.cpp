@@ -24,6 +24,21 @@ TEST(BenchCli, UnknownSuiteOrMissingDemFailsWithOneLine) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "report.md"));
 }
 
+TEST(BenchCli, ExactnessNeedsItsSceneAndAnExistingExecutableUnderTest) {
+  test::TempDir dir;
+  const std::string dem = std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt";
+  auto r = run_terravol("bench --suites exactness --under-test /nonexistent/terravol --dem " + dem + " -o " +
+                        dir.path().string());
+  EXPECT_NE(r.status, 0);  // CLI11's validation error
+  EXPECT_NE(r.err.find("/nonexistent/terravol"), std::string::npos) << r.err;
+  // A terrain without the scene is skipped with a message, not drawn.
+  r = run_terravol("bench --suites exactness --dem " + dem + " -o " + dir.path().string(), 120);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("exactness: no scene for N45E006"), std::string::npos) << r.err;
+  std::ifstream in(dir.path() / "results.json");
+  EXPECT_FALSE(nlohmann::json::parse(in).contains("exactness"));
+}
+
 TEST(BenchCli, ASmallRunOnTheBundledDemWritesResultsReportAndPlots) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;

@@ -1,0 +1,54 @@
+// What the independent reference (reference/check.h) reads of a scene file (docs/scene-file.md):
+// the DEMs and, per volume, its file, field, frame and visible styles. Parsed here with
+// nlohmann-json rather than through app/scene_file.h, which is part of what is checked. Only the
+// keys the reference draws are read; the camera and render style come from the render's own
+// outputs (its --export-vtp and --stats), and validating the file is the renderer's job: unknown
+// keys are ignored here.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace terravol::reference {
+
+struct IsoStyle {
+  float value = 0;                       // the field's units
+  std::array<std::uint8_t, 3> color{};   // sRGB
+  double opacity = 0.5;                  // alpha = round(opacity * 255)
+};
+
+enum class SliceKind : std::uint8_t { kLat, kLon, kAlt, kAgl };
+
+struct SliceStyle {
+  SliceKind kind = SliceKind::kAgl;
+  double value = 0;                  // degrees (lat, lon) or metres (alt above the datum, agl)
+  std::string colormap = "viridis";  // volume::colormap_by_name
+  double opacity = 0.5;
+  std::optional<float> lo, hi;       // default: the volume's finite minimum and maximum
+};
+
+struct VolumeStyle {
+  std::filesystem::path file;        // resolved against the scene file's folder
+  std::string field;                 // empty: the file's first grid or array
+  std::optional<std::string> frame;  // "geographic", "geographic-agl", "enu:LAT,LON,H"
+  bool visible = true;
+  std::vector<IsoStyle> isosurfaces;
+  std::vector<SliceStyle> slices;
+};
+
+struct Scene {
+  std::vector<std::filesystem::path> dems;  // resolved against the scene file's folder
+  std::vector<VolumeStyle> volumes;
+};
+
+// Reads a scene file. Isosurfaces without a colour take volume::default_isosurface_color of
+// their index within the volume, as docs/scene-file.md says ("a colour-blind-safe palette by
+// index"). Throws std::runtime_error("FILE: what is wrong") when the file cannot be read, is not
+// JSON, or a key the reference needs has the wrong type or is missing.
+Scene read_scene(const std::filesystem::path& file);
+
+}  // namespace terravol::reference
