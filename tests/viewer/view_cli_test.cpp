@@ -617,17 +617,20 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
 // Isosurfaces and slices are decimated to --surface-triangles each (12000 by default: this
 // volume's isosurface and slice give 23999 triangles), or to the scene file's
 // "surface_triangles"; the option wins over the file.
-TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceAndSliceFromTheOptionOrTheSceneFile) {
+TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceFromTheOptionOrTheSceneFileAndNeverASlice) {
   TERRAVOL_REQUIRE_XDOTOOL();
   test::TempDir dir;
   const auto vdb = dir.path() / "rf.vdb";
   ASSERT_TRUE(make_volume(vdb));
-  const auto scene = dir.path() / "scene.json";
-  std::ofstream(scene) << R"({"dem": ")" << bundled_dem() << R"(", "volumes": [{"file": ")" << vdb.string()
-                       << R"(", "isosurfaces": [{"value": 110}], "slices": [{"agl": 300}]}],
+  const auto write_scene = [&](const std::string& name, const std::string& styles) {
+    const auto scene = dir.path() / name;
+    std::ofstream(scene) << R"({"dem": ")" << bundled_dem() << R"(", "volumes": [{"file": ")" << vdb.string()
+                         << R"(", )" << styles << R"(}],
     "camera": {"lat": 45.44, "lon": 6.44, "alt": 2600, "heading": 40, "pitch": -18},
     "render": {"surface_triangles": 2000}})";
-  const auto input_triangles = [&](const std::string& args) -> std::size_t {
+    return scene;
+  };
+  const auto input_triangles = [&](const std::filesystem::path& scene, const std::string& args) -> std::size_t {
     Viewer v("--scene " + scene.string() + args + kSmall);
     if (!v.start()) return 0;
     const json s = v.settle();
@@ -636,12 +639,18 @@ TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceAndSliceFromTheOptionOrTheSce
     EXPECT_GT(s["merged_triangles"].get<std::size_t>(), 0u);
     return s["merge"]["input_triangles"].get<std::size_t>();
   };
-  const std::size_t from_file = input_triangles("");
+  const auto isos = write_scene("isos.json", R"("isosurfaces": [{"value": 105}, {"value": 110}])");
+  const std::size_t from_file = input_triangles(isos, "");
   EXPECT_GT(from_file, 0u);
-  EXPECT_LE(from_file, 2u * 2000u) << "the scene file's budget, for the isosurface and the slice";
-  const std::size_t from_option = input_triangles(" --surface-triangles 4000");
-  EXPECT_GT(from_option, 2u * 2000u) << "the option wins over the file";
+  EXPECT_LE(from_file, 2u * 2000u) << "the scene file's budget, for each isosurface";
+  const std::size_t from_option = input_triangles(isos, " --surface-triangles 4000");
+  EXPECT_GT(from_option, from_file) << "the option wins over the file";
   EXPECT_LE(from_option, 2u * 4000u);
+  // A slice keeps the volume's resolution whatever the budget.
+  const auto slice = write_scene("slice.json", R"("slices": [{"agl": 300}])");
+  const std::size_t slice_small = input_triangles(slice, " --surface-triangles 100");
+  EXPECT_GT(slice_small, 100u);
+  EXPECT_EQ(slice_small, input_triangles(slice, " --surface-triangles 0"));
 }
 
 TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
