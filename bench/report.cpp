@@ -32,7 +32,7 @@ double med(const json& s) { return s["median"].get<double>(); }
 
 const json* find_config(const json& terrain, const std::string& metric, double t) {
   for (const json& k : terrain["mrbsp"])
-    if (k["metric"] == metric && k["threshold"].get<double>() == t) return &k;
+    if (k["metric"] == metric && k["threshold"].get<double>() == t && !k.value("occlusion", false)) return &k;
   return nullptr;
 }
 
@@ -76,6 +76,21 @@ void terrain_section(std::ostringstream& md, const json& results, const std::fil
       }
       if (!st.x.empty()) tri.push_back(st);
       if (!se.x.empty()) err.push_back(se);
+    }
+    for (const json& k : t["mrbsp"]) {
+      if (!k.value("occlusion", false)) continue;
+      md << "| MRBSP error " << num(k["threshold"].get<double>()) << ", occlusion on | " << spread(k["frame_ms"]) << " | "
+         << spread(k["traversal_ms"]) << " (pass " << spread(k["occlusion_pass_ms"]) << ") | " << spread(k["draw_ms"])
+         << " | " << num(med(k["triangles"]), "%.0f") << " | " << spread(k["psnr_db"], "%.1f") << " | "
+         << num(med(k["ssim"]), "%.4f") << " | " << pct(med(k["share_over_8"])) << " | " << spread(k["plain_over_mrbsp"])
+         << " |\n";
+    }
+    for (const json& k : t["mrbsp"]) {
+      if (!k.value("occlusion", false)) continue;
+      md << "\nOcclusion at " << num(k["threshold"].get<double>()) << " px: images byte-identical to culling off in "
+         << pct(k["images_identical_to_off"].get<double>()) << " of the views; frame off / on "
+         << num(k["frame_off_over_on"].get<double>(), "%.2f") << "x; regions tested "
+         << num(med(k["occlusion_tested_nodes"]), "%.0f") << ".";
     }
     md << "\n";
     // Frame time along the path.

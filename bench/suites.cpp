@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <numeric>
 #include <memory>
 
 #include "app/output/png_output.h"
@@ -95,13 +96,31 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
   const std::vector<View> views = flythrough(scene.terrain().bounds(), c.views);
 
   struct Config {
-    mrbsp::LodMetric metric;
-    double t;
+    mrbsp::LodMetric metric = mrbsp::LodMetric::kError;
+    double t = 1.0;
+    bool occlusion = false;  // then compared with the configuration of index `off`
+    std::size_t off = 0;
     std::vector<double> traversal, upload, draw, frame, triangles, psnr, ssim, share8, ratio;
+    std::vector<double> identical, occlusion_ms, tested;  // occlusion on: per view
+    std::vector<std::uint8_t> image;                      // the last view's
   };
   std::vector<Config> configs;
   for (auto metric : {mrbsp::LodMetric::kError, mrbsp::LodMetric::kArea})
-    for (double t : {0.5, 1.0, 2.0, 4.0}) configs.push_back({metric, t, {}, {}, {}, {}, {}, {}, {}, {}, {}});
+    for (double t : {0.5, 1.0, 2.0, 4.0}) {
+      Config k;
+      k.metric = metric;
+      k.t = t;
+      configs.push_back(std::move(k));
+    }
+  // Occlusion culling (Greene 1996) side by side with the same thresholds without it.
+  for (std::size_t off : {std::size_t{1}, std::size_t{2}}) {
+    Config k;
+    k.metric = mrbsp::LodMetric::kError;
+    k.t = configs[off].t;
+    k.occlusion = true;
+    k.off = off;
+    configs.push_back(std::move(k));
+  }
   std::vector<double> plain_ms, full_triangles, plain_psnr;
   mrbsp::TraversalOptions full;
   full.full_res = true;
@@ -120,7 +139,8 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
     plain_psnr.push_back(psnr(plain->rgb(), reference, c.width, c.height));
 
     for (Config& k : configs) {
-      const mrbsp::TraversalOptions o = lod(k.metric, k.t);
+      mrbsp::TraversalOptions o = lod(k.metric, k.t);
+      o.occlusion = k.occlusion;
       if (v == 0) scene.render(pose, true, 45.0, o);  // warm-up
       std::vector<double> tr, up, dr, fr;
       app::render::FrameStats s;
@@ -131,7 +151,12 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
         dr.push_back(s.draw_ms);
         fr.push_back(frame_ms(s));
       }
-      const std::vector<std::uint8_t> image = scene.rgb();
+      std::vector<std::uint8_t> image = scene.rgb();
+      if (k.occlusion) {
+        k.identical.push_back(image == configs[k.off].image ? 1.0 : 0.0);
+        k.occlusion_ms.push_back(scene.last_frame().occlusion.pass_ms);
+        k.tested.push_back(static_cast<double>(scene.last_frame().occlusion.tested_nodes));
+      }
       k.traversal.push_back(median(tr));
       k.upload.push_back(median(up));
       k.draw.push_back(median(dr));
@@ -141,6 +166,7 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
       k.ssim.push_back(ssim(image, reference, c.width, c.height));
       k.share8.push_back(share_differing(image, reference, c.width, c.height, 8));
       k.ratio.push_back(plain_ms.back() / k.frame.back());
+      k.image = std::move(image);
     }
     char b[160];
     std::snprintf(b, sizeof b, "terrain %s: view %zu/%zu  plain VTK %.0f ms, MRBSP 1 px %.1f ms", terrain.name.c_str(),
@@ -165,6 +191,14 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
     j["metric"] = k.metric == mrbsp::LodMetric::kError ? "error" : "area";
     j["threshold"] = k.t;
     j["threshold_px_or_px2"] = lod(k.metric, k.t).threshold_px;
+    j["occlusion"] = k.occlusion;
+    if (k.occlusion) {
+      j["images_identical_to_off"] =
+          std::accumulate(k.identical.begin(), k.identical.end(), 0.0) / static_cast<double>(k.identical.size());
+      j["occlusion_pass_ms"] = to_json(summarize(k.occlusion_ms));
+      j["occlusion_tested_nodes"] = to_json(summarize(k.tested));
+      j["frame_off_over_on"] = summarize(configs[k.off].frame).median / summarize(k.frame).median;
+    }
     j["traversal_ms"] = to_json(summarize(k.traversal));
     j["upload_ms"] = to_json(summarize(k.upload));
     j["draw_ms"] = to_json(summarize(k.draw));
