@@ -55,17 +55,7 @@ TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
 }
 
 // A camera at `eye` looking along `forward` (not vertical), 60 degrees wide.
-Camera camera_at(const glm::dvec3& eye, glm::dvec3 forward) {
-  Camera c;
-  c.eye = eye;
-  c.forward = glm::normalize(forward);
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
-  c.fov_y_deg = 60.0;
-  c.width = 320;
-  c.height = 200;
-  c.near_plane = 0.5;
-  return c;
-}
+Camera camera_at(const glm::dvec3& eye, glm::dvec3 forward) { return test::looking(eye, forward, 60.0, 320, 200, 0.5); }
 
 // The window's footprint: 16 cells of 100 m from the origin.
 constexpr double kX0 = 0.0, kX1 = 1600.0;

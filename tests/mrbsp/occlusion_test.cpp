@@ -30,15 +30,7 @@ TestWindow ridged() {
 }
 
 Camera low_eye(double x, double y, double z, double heading_x, double pitch) {
-  Camera c;
-  c.eye = {x, y, z};
-  c.forward = glm::normalize(glm::dvec3(heading_x, 1.0, pitch));
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
-  c.fov_y_deg = 50.0;
-  c.width = 400;
-  c.height = 240;
-  c.near_plane = 1.0;
-  return c;
+  return test::looking({x, y, z}, {heading_x, 1.0, pitch}, 50.0, 400, 240, 1.0);
 }
 
 using Tri = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>;

@@ -45,6 +45,20 @@ struct SlidingTerrain {
 };
 
 // Distance along the ray to the triangle, or a negative value when it misses (Moller-Trumbore).
+// A camera at `eye` looking along `forward` (not vertical), level, fov_y degrees high.
+inline Camera looking(const glm::dvec3& eye, const glm::dvec3& forward, double fov_y, int width, int height,
+                      double near_plane) {
+  Camera c;
+  c.eye = eye;
+  c.forward = glm::normalize(forward);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  c.fov_y_deg = fov_y;
+  c.width = width;
+  c.height = height;
+  c.near_plane = near_plane;
+  return c;
+}
+
 inline double ray_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
                     const glm::dvec3& c) {
   const glm::dvec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
