@@ -459,6 +459,10 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   }
   shade_.resize(shade_.size() + positions.size(), 1.0f);
   point_rgba_.insert(point_rgba_.end(), rgba.begin(), rgba.end());
+  // Translucent newcomers turn blending on (it stays on: what was translucent still is).
+  if (std::any_of(rgba.begin(), rgba.end(), [](const scene::Rgba& c) { return c[3] != 255; })) {
+    if (auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_)) ordered->set_blending(true);
+  }
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
 }
