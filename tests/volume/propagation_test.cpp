@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "io/mosaic.h"
+#include "io/scene_frame.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
 
@@ -306,6 +307,119 @@ TEST(Rf, RejectsBadParameters) {
   EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt}, grid), std::invalid_argument);
   EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt}, grid), std::invalid_argument);
   EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0}, grid), std::invalid_argument);
+}
+
+RfOptions itm_options() {
+  RfOptions o;
+  o.model = RfModel::kItm;
+  return o;
+}
+
+TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
+  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
+  const Transmitter tx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {2.0, 52.0, 102.0};
+  RfOptions o = itm_options();
+  o.itm.climate = ItmClimate::kMaritimeTemperateOverLand;
+  o.itm.time = 0.9;
+  const Volume v = compute_rf(dem, tx, grid, o).path_loss;
+  EXPECT_NE(v.attributes.at("model").find("Longley-Rice ITM"), std::string::npos);
+  EXPECT_FALSE(v.attributes.contains("k_factor"));
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double step = std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
+  const std::pair<int, int> columns[] = {{0, 0}, {3, 7}, {v.lattice.dims[0] - 1, 5}, {12, v.lattice.dims[1] - 1}};
+  for (const auto& [i, j] : columns) {
+    TerrainProfile profile;
+    sample_profile(dem, tx.lat, tx.lon, v.lattice.world(1, j), v.lattice.world(0, i), step, profile);
+    const double spacing = profile.distance_m / static_cast<double>(profile.ground_m.size() - 1);
+    for (int k = 0; k < 3; ++k) {
+      const ItmLoss expected = itm_point_to_point(profile.ground_m, spacing, tx.height_agl, grid.heights_agl[k], tx.frequency_mhz, o.itm);
+      EXPECT_FLOAT_EQ(v.at(i, j, k), static_cast<float>(expected.loss_db)) << i << " " << j << " " << k;
+    }
+  }
+}
+
+TEST(RfItm, LossGrowsWithDistanceOverFlatGroundAndHasNoValueAtTheTransmitter) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 25.0;
+  grid.spacing_arcsec = 15.0;
+  grid.heights_agl = {2.0, 52.0, 102.0};
+  const RfResult r = compute_rf(flat, tx, grid, itm_options());
+  const Volume& v = r.path_loss;
+  const auto [it, jt] = tx_column(v, tx);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(std::isnan(v.at(it, jt, k)));
+    for (int i = it + 2; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
+    for (int i = it - 2; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
+    for (int j = jt + 2; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
+  }
+  // Beyond the radio horizon of 30 m and 2 m antennas (about 28 km), the far corner at 2 m is
+  // well below free space, and higher receivers see less loss.
+  const int far = v.lattice.dims[0] - 1;
+  const double d = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
+  EXPECT_GT(v.at(far, 0, 0), 32.45 + 20.0 * std::log10(900.0) + 20.0 * std::log10(d / 1000.0) + 10.0);
+  EXPECT_LT(v.at(far, 0, 2), v.at(far, 0, 0));
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_EQ(r.notes[0], "ITM has no value at the transmitter's own column (NaN)");
+}
+
+TEST(RfItm, LossGrowsBehindARidge) {
+  const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 12.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {10.0, 210.0, 410.0, 610.0, 810.0};
+  const Volume v = compute_rf(dem, tx, grid, itm_options()).path_loss;
+  const auto [it, jt] = tx_column(v, tx);
+  const int east = v.lattice.dims[0] - 1;
+  const double d_east = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, east));
+  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);
+  for (int k = 1; k < 5; ++k) EXPECT_LT(v.at(east, jt, k), v.at(east, jt, k - 1)) << k;
+  for (int i = it; i < v.lattice.dims[0]; ++i) {
+    if (v.lattice.world(0, i) <= 6.565) continue;
+    const double d = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, i));
+    EXPECT_GT(v.at(i, jt, 0), free_space_loss_db(d, 900.0) + 15.0) << i;
+  }
+}
+
+TEST(RfItm, RejectsParametersOutsideTheModelsRange) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
+  RfGrid grid;
+  grid.radius_km = 2.0;
+  grid.heights_agl = {10.0};
+  auto message = [&](const Transmitter& tx, const RfGrid& g, const RfOptions& o) {
+    try {
+      compute_rf(flat, tx, g, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  RfOptions o = itm_options();
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 10.0, std::nullopt}, grid, o),
+            "ITM frequency 10 MHz: must be within [20, 20000] MHz");
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 0.2, 900.0, std::nullopt}, grid, o),
+            "transmitter height 0.2: ITM takes antenna heights within [0.5, 3000] m above ground");
+  RfGrid low = grid;
+  low.heights_agl = {0.0, 50.0};
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, low, o),
+            "height 0: ITM takes antenna heights within [0.5, 3000] m above ground");
+  o.itm.climate = static_cast<ItmClimate>(0);
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, grid, o).rfind("ITM climate 0: must be within 1..7", 0), 0u);
+  // The default heights start at 10 m for ITM, 0 for Deygout.
+  RfGrid defaults;
+  defaults.radius_km = 1.0;
+  defaults.spacing_arcsec = 30.0;
+  const Lattice l = compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, defaults, itm_options()).path_loss.lattice;
+  EXPECT_EQ(l.dims[2], 41);
+  EXPECT_EQ(l.world(2, 0), 10.0);
+  EXPECT_EQ(l.world(2, 40), 2010.0);
 }
 
 TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
