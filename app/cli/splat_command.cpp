@@ -34,6 +34,7 @@ struct SplatCommandOptions {
   int cells_per_degree = volume::kSplatCellsPerDegree;
   bool force = false;
   bool quiet = false;
+  bool olditm = false;
 };
 
 std::string fmt(double v) {
@@ -70,6 +71,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     throw std::runtime_error("--sdf " + o.sdf.string() + ": not used with --import");
   if (importing && !o.ano_dir.empty())
     throw std::runtime_error("--ano-dir: not used with --import");
+  if (importing && o.olditm) throw std::runtime_error("--olditm: not used with --import");
   if (!importing && o.sdf.empty())
     throw std::runtime_error("--sdf: the folder of SDF tiles is required to run SPLAT!");
   if (!importing && o.cells_per_degree != volume::kSplatCellsPerDegree) {
@@ -164,6 +166,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     run.radius_km = o.radius_km;
     run.timeout_seconds = o.timeout_seconds;
     run.keep_ano_texts = !o.ano_dir.empty();
+    run.olditm = o.olditm;
     const bool show_progress = !o.quiet && ::isatty(2);
     if (show_progress) {
       run.progress = [n = heights.size()](std::size_t done) {
@@ -181,7 +184,8 @@ void run_splat_volume(const SplatCommandOptions& o) {
     for (const auto& t : r.tiles) tiles += (tiles.empty() ? "" : ", ") + t;
     attributes["model"] =
         "SPLAT! " + (r.version.empty() ? std::string("(version unknown)") : "v" + r.version) +
-        " area path loss (ITWOM), splat -L H -R " + fmt(o.radius_km) + " -metric -erp 0";
+        " area path loss (" + (o.olditm ? "ITM" : "ITWOM") + "), splat -L H -R " + fmt(o.radius_km) +
+        " -metric -erp 0" + (o.olditm ? " -olditm" : "");
     attributes["radius_km"] = fmt(o.radius_km);
     attributes["dem"] = tiles;
     summary = "SPLAT! " + r.version + ": " + std::to_string(heights.size()) + " runs in " +
@@ -281,6 +285,8 @@ void add_splat_command(CLI::App& app) {
   cmd->add_option("--timeout", o->timeout_seconds, "Seconds allowed for each SPLAT! run")
       ->capture_default_str();
   cmd->add_option("--ano-dir", o->ano_dir, "Also keep SPLAT!'s -ano files there (splat-LHm.ano)");
+  cmd->add_flag("--olditm", o->olditm,
+                "Run SPLAT!'s Longley-Rice ITM (splat -olditm) instead of its default ITWOM");
   cmd->add_flag("--force", o->force, "Replace existing output files");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] { run_splat_volume(*o); });
