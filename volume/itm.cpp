@@ -133,6 +133,15 @@ struct Geometry {
 struct Medium {
   double wn = 0.0, ens = 0.0, gme = 0.0;
   Complex zg;
+  double inverse_abs_zg = 0.0;  // 1 / |Z_g|
+  double xae = 0.0;             // (k gamma_e^2)^(-1/3)
+};
+
+// What the statistics take from the frequency and the climate alone.
+struct Statistics {
+  const Climate* climate = nullptr;
+  double g_minus = 0.0, g_plus = 0.0;  // the frequency factors
+  double dexa_frequency_m = 0.0;       // the frequency's part of d_e's scale, (575.7e12 / k)^(1/3)
 };
 
 // Delta h(d) = (1 - 0.8 exp(-d / 50 km)) Delta h: the irregularity seen over a distance d.
@@ -191,24 +200,27 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, std:
   const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
   const int n = 10 * ka - 5;
   s.resize(static_cast<std::size_t>(n));
+  // Linear interpolation at n equally spaced points from xa to xb; k walks along the profile
+  // (the interval ends at sample k, or the last one).
   const double step = (xb - xa) / (n - 1);
+  int k = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
   double sum = 0.0, sum_i = 0.0;
   for (int j = 0; j < n; ++j) {
     const double p = xa + j * step;
-    const int k = std::clamp(static_cast<int>(std::floor(p)) + 1, 1, np);
+    while (p > k && k < np) ++k;
     const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
     s[static_cast<std::size_t>(j)] = v;
     sum += v;
     sum_i += j * v;
   }
   const Line line = trapezoid_fit(sum, sum_i, s.front(), s.back(), 0, n - 1);
-  for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] -= line.at(j);
-  const auto kth = s.begin() + (ka - 1);
-  std::nth_element(s.begin(), kth, s.end(), std::greater<>());
-  const double upper = *kth;  // the ka-th largest
-  std::nth_element(s.begin(), kth, s.end());
-  const double lower = *kth;  // the ka-th smallest
-  return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
+  const double at0 = line.at(0.0);
+  for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] -= at0 + line.slope * j;
+  // The ka-th smallest, then the ka-th largest among the values above it.
+  const auto lower = s.begin() + (ka - 1), upper = s.begin() + (n - ka);
+  std::nth_element(s.begin(), lower, s.end());
+  std::nth_element(lower + 1, upper, s.end());
+  return (*upper - *lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
 // The diffraction attenuation A_diff(d) (4.11) for one geometry: with the weight w, the
@@ -222,7 +234,7 @@ class Diffraction {
     wd1_ = std::sqrt(1.0 + (g.he[0] * g.he[1] - hgg) / (hgg + 10.0));
     xd1_ = dla + tha / m.gme;
     afo_ = std::min(15.0, 2.171 * std::log(1.0 + 4.77e-4 * hgg * m.wn * sigma_h(delta_h_over(dlsa, g.dh))));
-    qk_ = 1.0 / std::abs(m.zg);
+    qk_ = m.inverse_abs_zg;
     for (int j = 0; j < 2; ++j) {
       const double a = 0.5 * g.dl[j] * g.dl[j] / g.he[j];  // the horizon's radius
       const double wa = std::cbrt(a * m.wn);
@@ -363,7 +375,7 @@ Reference reference_attenuation(const Geometry& g, const Medium& m) {
 
   // The diffraction line through two distances beyond the smooth-Earth horizons.
   const Diffraction diffraction(g, m, dlsa, dla, tha);
-  const double xae = std::cbrt(1.0 / (m.wn * m.gme * m.gme));
+  const double xae = m.xae;
   const double d3 = std::max(dlsa, 1.3787 * xae + dla), d4 = d3 + 2.7574 * xae;
   const double a3 = diffraction.at(d3), a4 = diffraction.at(d4);
   const double emd = (a4 - a3) / (d4 - d3), aed = a3 - emd * d3;
@@ -437,14 +449,13 @@ Reference reference_attenuation(const Geometry& g, const Medium& m) {
 }
 
 // The requested quantile of attenuation (the Algorithm, "statistics").
-double variability(double aref, const Geometry& g, const Medium& m, const ItmParameters& p, double zt, double zl,
-                   double zc, int& warning) {
-  const Climate& c = kClimates[static_cast<int>(p.climate) - 1];
-  const double ln_k = std::log(0.133 * m.wn);
-  const double gm = c.g_minus(ln_k), gp = c.g_plus(ln_k);
+double variability(double aref, const Geometry& g, const Medium& m, const Statistics& st, const ItmParameters& p,
+                   double zt, double zl, double zc, int& warning) {
+  const Climate& c = *st.climate;
+  const double gm = st.g_minus, gp = st.g_plus;
   // The effective distance d_e: 130 km at the sum of the smooth-Earth horizons plus a
   // frequency term, proportional before it and growing one for one after.
-  const double dexa = std::sqrt(18e6 * g.he[0]) + std::sqrt(18e6 * g.he[1]) + std::cbrt(575.7e12 / m.wn);
+  const double dexa = std::sqrt(18e6 * g.he[0]) + std::sqrt(18e6 * g.he[1]) + st.dexa_frequency_m;
   const double de = g.dist < dexa ? 130e3 * g.dist / dexa : 130e3 + g.dist - dexa;
   const double vmd = c.median(de);
   const double sgtm = c.sigma_minus(de) * gm, sgtp = c.sigma_plus(de) * gp;
@@ -548,6 +559,12 @@ ItmPath::ItmPath(double frequency_mhz, const ItmParameters& parameters)
   if (parameters.polarization == ItmPolarization::kVertical) zg /= eps;
   zg_re_ = zg.real();
   zg_im_ = zg.imag();
+  inverse_abs_zg_ = 1.0 / std::abs(zg);
+  const Climate& climate = kClimates[static_cast<int>(parameters.climate) - 1];
+  const double ln_k = std::log(0.133 * wn_);
+  g_minus_ = climate.g_minus(ln_k);
+  g_plus_ = climate.g_plus(ln_k);
+  dexa_frequency_m_ = std::cbrt(575.7e12 / wn_);
   z_time_ = itm_functions::inverse_normal(parameters.time);
   z_location_ = itm_functions::inverse_normal(parameters.location);
   z_situation_ = itm_functions::inverse_normal(parameters.situation);
@@ -577,6 +594,7 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   const double zs = (sum_z_[static_cast<std::size_t>(n_ - p10 + 1)] - sum_z_[static_cast<std::size_t>(p10)]) /
                     (n_ - 2 * p10 + 1);
   ns_ = p_.refractivity * std::exp(-zs / 9460.0);
+  free_space_path_db_ = 32.45 + 20.0 * std::log10(frequency_mhz_) + 20.0 * std::log10(dist_ / 1000.0);
   gme_ = kGammaA * (1.0 - 0.04665 * std::exp(ns_ / 179.3));
 
   // Horizon terms: elevation angles on the Earth of curvature gamma_e (heights relative to the
@@ -599,6 +617,44 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
     rx_u_[static_cast<std::size_t>(i)] = 1.0 / sb;
   }
   dh_x1_ = dh_x2_ = -1.0;
+  rx_hull_built_ = false;
+  xae_ = std::cbrt(1.0 / (wn_ * gme_ * gme_));
+}
+
+int ItmPath::receiver_horizon(double zb) {
+  // The elevation angle of sample i seen from the receiver at height zb is the line
+  // a_i - u_i zb, u_i = 1 / (distance to it) growing with i; the steepest sample is the upper
+  // envelope of these lines at zb, which moves to smaller i as zb grows. The envelope is built
+  // once per profile (in order of increasing slope -u_i), and successive heights walk along
+  // it.
+  if (!rx_hull_built_) {
+    rx_hull_.clear();
+    for (int i = n_ - 1; i >= 1; --i) {
+      const double a3 = rx_a_[static_cast<std::size_t>(i)], u3 = rx_u_[static_cast<std::size_t>(i)];
+      while (rx_hull_.size() >= 2) {
+        const auto l1 = static_cast<std::size_t>(rx_hull_[rx_hull_.size() - 2]);
+        const auto l2 = static_cast<std::size_t>(rx_hull_.back());
+        // l2 is never above both neighbours when l1 and l3 cross at or before l1 and l2 do.
+        if ((rx_a_[l1] - a3) * (rx_u_[l1] - rx_u_[l2]) <= (rx_a_[l1] - rx_a_[l2]) * (rx_u_[l1] - u3)) {
+          rx_hull_.pop_back();
+        } else {
+          break;
+        }
+      }
+      rx_hull_.push_back(i);
+    }
+    rx_hull_built_ = true;
+    rx_hull_at_ = 0;
+    rx_hull_last_zb_ = -std::numeric_limits<double>::infinity();
+  }
+  if (zb < rx_hull_last_zb_) rx_hull_at_ = 0;
+  rx_hull_last_zb_ = zb;
+  auto value = [&](std::size_t h) {
+    const auto i = static_cast<std::size_t>(rx_hull_[h]);
+    return rx_a_[i] - zb * rx_u_[i];
+  };
+  while (rx_hull_at_ + 1 < rx_hull_.size() && value(rx_hull_at_ + 1) >= value(rx_hull_at_)) ++rx_hull_at_;
+  return rx_hull_[rx_hull_at_];
 }
 
 double ItmPath::delta_h(double x1, double x2) {
@@ -627,17 +683,12 @@ ItmLoss ItmPath::loss(double rx_height_m) {
   if (tx_best_angle_ > g.the[0]) {
     g.the[0] = tx_best_angle_;
     g.dl[0] = tx_best_distance_;
-    double best = g.the[1];
-    int best_i = n_;
-    for (int i = 1; i < n_; ++i) {
-      const double angle = rx_a_[static_cast<std::size_t>(i)] - zb * rx_u_[static_cast<std::size_t>(i)];
-      if (angle > best) {
-        best = angle;
-        best_i = i;
-      }
+    const int i = receiver_horizon(zb);
+    const double angle = rx_a_[static_cast<std::size_t>(i)] - zb * rx_u_[static_cast<std::size_t>(i)];
+    if (angle > g.the[1]) {
+      g.the[1] = angle;
+      g.dl[1] = dist_ - i * xi_;
     }
-    g.the[1] = best;
-    g.dl[1] = dist_ - best_i * xi_;
   }
 
   // Terrain irregularity between the foregrounds, then the effective heights.
@@ -679,14 +730,17 @@ ItmLoss ItmPath::loss(double rx_height_m) {
   m.ens = ns_;
   m.gme = gme_;
   m.zg = Complex(zg_re_, zg_im_);
+  m.inverse_abs_zg = inverse_abs_zg_;
+  m.xae = xae_;
   const Reference ref = reference_attenuation(g, m);
 
   ItmLoss out;
   out.warning = ref.warning;
   out.reference_db = ref.aref;
   out.mode = ref.mode;
-  out.attenuation_db = variability(ref.aref, g, m, p_, z_time_, z_location_, z_situation_, out.warning);
-  out.free_space_db = 32.45 + 20.0 * std::log10(frequency_mhz_) + 20.0 * std::log10(dist_ / 1000.0);
+  const Statistics statistics{&kClimates[static_cast<int>(p_.climate) - 1], g_minus_, g_plus_, dexa_frequency_m_};
+  out.attenuation_db = variability(ref.aref, g, m, statistics, p_, z_time_, z_location_, z_situation_, out.warning);
+  out.free_space_db = free_space_path_db_;
   out.loss_db = out.free_space_db + out.attenuation_db;
   out.surface_refractivity = ns_;
   out.earth_curvature = gme_;

@@ -103,9 +103,12 @@ class ItmPath {
 
  private:
   double delta_h(double x1_m, double x2_m);
+  int receiver_horizon(double zb);  // the interior sample of steepest elevation seen from zb
 
   double wn_ = 0.0;                   // wave number, 1/m (the Algorithm's k = f / 47.7 MHz m)
   double zg_re_ = 0.0, zg_im_ = 0.0;  // surface transfer impedance of the ground
+  double inverse_abs_zg_ = 0.0;
+  double g_minus_ = 0.0, g_plus_ = 0.0, dexa_frequency_m_ = 0.0;  // the statistics' frequency terms
   double frequency_mhz_ = 0.0;
   ItmParameters p_;
   double z_time_ = 0.0, z_location_ = 0.0, z_situation_ = 0.0;  // standard normal deviates
@@ -115,9 +118,16 @@ class ItmPath {
   std::vector<double> sum_z_, sum_iz_;   // prefix sums of z_i and i z_i, for line fits
   std::vector<double> rx_a_, rx_u_;      // the receiver's horizon angle of sample i is
                                          // rx_a_[i] - z_rx * rx_u_[i]
+  // The upper envelope of those lines in z_rx (sample indices, from low z_rx to high; built
+  // when a receiver first has a horizon), and the last query's place on it.
+  std::vector<int> rx_hull_;
+  bool rx_hull_built_ = false;
+  std::size_t rx_hull_at_ = 0;
+  double rx_hull_last_zb_ = 0.0;
   int n_ = 0;                            // intervals
   double xi_ = 0.0, dist_ = 0.0, hg_tx_ = 0.0;
-  double ns_ = 0.0, gme_ = 0.0;
+  double ns_ = 0.0, gme_ = 0.0, free_space_path_db_ = 0.0;
+  double xae_ = 0.0;  // (k gamma_e^2)^(-1/3), the diffraction's distance scale
   double tx_best_angle_ = 0.0, tx_best_distance_ = 0.0;  // steepest interior sample from the
                                                         // transmitter
   // Delta h depends on the window (x1, x2) only: the last one is kept.

@@ -229,6 +229,48 @@ TEST(Itm, ManyHeightsOnOnePathEqualSeparateCalls) {
   }
 }
 
+// The horizons of a trans-horizon path are the profile's steepest samples from each end, on
+// the Earth of curvature gamma_e: checked by brute force over random profiles and receiver
+// heights in random order (the path keeps state from one height to the next).
+TEST(ItmProperty, HorizonsAreTheSteepestSamples) {
+  std::mt19937 rng(31337);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 20 + static_cast<int>(300 * unit(rng));
+    const double spacing = 30.0 + 100.0 * unit(rng);
+    std::vector<double> z;
+    for (int i = 0; i <= n; ++i) z.push_back(500.0 + 300.0 * std::sin(i / (2.0 + 20.0 * unit(rng))) * unit(rng));
+    const double tx = 1.0 + 50.0 * unit(rng);
+    ItmPath path(300.0 + 3000.0 * unit(rng), ItmParameters{});
+    path.set_profile(z, spacing, tx);
+    for (int k = 0; k < 20; ++k) {
+      const double rx = 1.0 + 300.0 * unit(rng);
+      const ItmLoss r = path.loss(rx);
+      const double qc = 0.5 * r.earth_curvature, d = n * spacing;
+      const double za = z[0] + tx, zb = z[static_cast<std::size_t>(n)] + rx;
+      double best0 = (zb - za) / d - qc * d, best1 = (za - zb) / d - qc * d, dl0 = d, dl1 = d;
+      for (int i = 1; i < n; ++i) {
+        const double s = i * spacing, sb = d - s, zi = z[static_cast<std::size_t>(i)];
+        if ((zi - za) / s - qc * s > best0) {
+          best0 = (zi - za) / s - qc * s;
+          dl0 = s;
+        }
+        if ((zi - zb) / sb - qc * sb > best1) {
+          best1 = (zi - zb) / sb - qc * sb;
+          dl1 = sb;
+        }
+      }
+      if (dl0 + dl1 > 1.5 * d) continue;  // line of sight or nearly: the Algorithm re-derives the horizons
+      ASSERT_NEAR(r.horizon_distance_m[0], dl0, 1e-6) << trial << " " << k;
+      ASSERT_NEAR(r.horizon_distance_m[1], dl1, 1e-6) << trial << " " << k;
+      ASSERT_NEAR(r.horizon_angle_rad[1], best1, 1e-12) << trial << " " << k;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+}
+
 // Random profiles: the model is finite, symmetric in its ends (the Algorithm treats both
 // terminals alike), and more variability never lowers the loss quantile beyond the median.
 TEST(ItmProperty, FiniteAndSymmetricInItsEnds) {
