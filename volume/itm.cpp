@@ -53,7 +53,9 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -144,6 +146,22 @@ struct Statistics {
   double dexa_frequency_m = 0.0;       // the frequency's part of d_e's scale, (575.7e12 / k)^(1/3)
 };
 
+// The cube root of x > 0, to the last bit or two (relative error under 1e-15): an estimate
+// from the exponent bits refined by two Halley steps and one Newton step. Written here
+// because the C library's cbrt was the model's most expensive function (four per point).
+double cube_root(double x) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = bits / 3 + 0x2A9F7893782DA1CEull;
+  double y = 0.0;
+  std::memcpy(&y, &bits, sizeof y);
+  for (int k = 0; k < 2; ++k) {
+    const double y3 = y * y * y;
+    y = y * (y3 + 2.0 * x) / (2.0 * y3 + x);
+  }
+  return y - (y * y * y - x) / (3.0 * y * y);
+}
+
 // Delta h(d) = (1 - 0.8 exp(-d / 50 km)) Delta h: the irregularity seen over a distance d.
 double delta_h_over(double d, double dh) { return (1.0 - 0.8 * std::exp(-d / 50e3)) * dh; }
 
@@ -193,12 +211,40 @@ void fit_window(double x1, double x2, double xi, int n, int& ja, int& jb) {
   jb = static_cast<int>(b);
 }
 
-double delta_h_of(const double* z, int np, double xi, double x1, double x2, std::vector<double>& s) {
+// The k-th smallest (0-based) of s, guided by a guess of it: a branch-free pass gathers the
+// values at or below a threshold a little above the guess (then, if too few, a little more);
+// when those are at least k + 1 and not too many, the answer is among them, else s is
+// searched whole. Exact either way; the
+// guess only decides how fast. Reorders s; scratch holds the gathered values.
+double kth_smallest(std::vector<double>& s, std::size_t k, double guess, double margin, std::vector<double>& scratch) {
+  const std::size_t n = s.size();
+  if (std::isfinite(guess) && margin > 0.0) {
+    scratch.resize(n);
+    for (const double threshold : {guess + margin, guess + 5.0 * margin}) {
+      std::size_t count = 0;
+      for (const double v : s) {
+        scratch[count] = v;
+        count += v <= threshold ? 1 : 0;
+      }
+      if (count > 4 * (k + 1)) break;
+      if (count > k) {
+        std::nth_element(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(k),
+                         scratch.begin() + static_cast<std::ptrdiff_t>(count));
+        return scratch[k];
+      }
+    }
+  }
+  std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(k), s.end());
+  return s[k];
+}
+
+double delta_h_of(const double* z, int np, double xi, double x1, double x2, DeltaHScratch& w) {
   const double xa = in_samples(x1, xi), xb = in_samples(x2, xi);
   const double span = snap(xb - xa);
   if (span < 2.0) return 0.0;
   const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
   const int n = 10 * ka - 5;
+  std::vector<double>& s = w.samples;
   s.resize(static_cast<std::size_t>(n));
   // Linear interpolation at n equally spaced points from xa to xb; k walks along the profile
   // (the interval ends at sample k, or the last one).
@@ -216,11 +262,16 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, std:
   const Line line = trapezoid_fit(sum, sum_i, s.front(), s.back(), 0, n - 1);
   const double at0 = line.at(0.0);
   for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] -= at0 + line.slope * j;
-  // The ka-th smallest, then the ka-th largest among the values above it.
-  const auto lower = s.begin() + (ka - 1), upper = s.begin() + (n - ka);
-  std::nth_element(s.begin(), lower, s.end());
-  std::nth_element(lower + 1, upper, s.end());
-  return (*upper - *lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
+  // The ka-th smallest and the ka-th largest (the smallest of the negated values), guided by
+  // the last ones found.
+  const auto rank = static_cast<std::size_t>(ka - 1);
+  const double margin = 0.02 * (w.upper - w.lower);
+  const double lower = kth_smallest(s, rank, w.lower, margin, w.gathered);
+  for (double& v : s) v = -v;
+  const double upper = -kth_smallest(s, rank, -w.upper, margin, w.gathered);
+  w.lower = lower;
+  w.upper = upper;
+  return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
 // The diffraction attenuation A_diff(d) (4.11) for one geometry: with the weight w, the
@@ -237,7 +288,7 @@ class Diffraction {
     qk_ = m.inverse_abs_zg;
     for (int j = 0; j < 2; ++j) {
       const double a = 0.5 * g.dl[j] * g.dl[j] / g.he[j];  // the horizon's radius
-      const double wa = std::cbrt(a * m.wn);
+      const double wa = cube_root(a * m.wn);
       const double pk = qk_ / wa;
       const double x = (1.607 - pk) * 151.0 * wa * g.dl[j] / a;
       xht_ += x;
@@ -252,7 +303,7 @@ class Diffraction {
     const double knife = itm_functions::knife_edge_db(v2 * g_.dl[0] / (ds + g_.dl[0])) +
                          itm_functions::knife_edge_db(v2 * g_.dl[1] / (ds + g_.dl[1]));
     const double a = ds / th;
-    const double wa = std::cbrt(a * wn_);
+    const double wa = cube_root(a * wn_);
     const double pk = qk_ / wa;
     const double x = (1.607 - pk) * 151.0 * wa * th + xht_;
     const double rounded = 0.05751 * x - 4.343 * std::log(x) - aht_;
@@ -279,13 +330,22 @@ class LineOfSight {
     const double sh = sigma_h(delta_h_over(d, g_.dh));
     const double hsum = g_.he[0] + g_.he[1];
     const double sin_psi = hsum / std::sqrt(d * d + hsum * hsum);
-    Complex r = (sin_psi - m_.zg) / (sin_psi + m_.zg) * std::exp(-std::min(10.0, m_.wn * sh * sin_psi));
-    const double r2 = std::norm(r);
-    if (r2 < 0.25 || r2 < sin_psi) r *= std::sqrt(sin_psi / r2);
+    // R = (sin psi - Z_g) / (sin psi + Z_g) exp(-min(10, k sigma_h sin psi)), in real arithmetic.
+    const double zr = m_.zg.real(), zi = m_.zg.imag();
+    const double nr = sin_psi - zr, dr = sin_psi + zr;  // numerator -i zi, denominator +i zi
+    const double scale = std::exp(-std::min(10.0, m_.wn * sh * sin_psi)) / (dr * dr + zi * zi);
+    double rr = (nr * dr - zi * zi) * scale, ri = (-zi * dr - nr * zi) * scale;
+    const double r2 = rr * rr + ri * ri;
+    if (r2 < 0.25 || r2 < sin_psi) {
+      const double f = std::sqrt(sin_psi / r2);
+      rr *= f;
+      ri *= f;
+    }
     const double extended = emd_ * d + aed_;
     double delta = 2.0 * m_.wn * g_.he[0] * g_.he[1] / d;  // the rays' phase difference
     if (delta > 1.57) delta = 3.14 - 2.4649 / delta;
-    const double two_ray = -4.343 * std::log(std::norm(Complex(std::cos(delta), -std::sin(delta)) + r));
+    const double sum_r = std::cos(delta) + rr, sum_i = -std::sin(delta) + ri;
+    const double two_ray = -4.343 * std::log(sum_r * sum_r + sum_i * sum_i);
     return (two_ray - extended) * wls_ + extended;
   }
 
@@ -396,10 +456,12 @@ Reference reference_attenuation(const Geometry& g, const Medium& m) {
     const double a1 = los.at(d1);
     double ak1 = 0.0, ak2 = 0.0;
     bool fitted = false;
+    const double ln_d2 = std::log(d2);
     if (d0 < d1) {
       const double a0 = los.at(d0);
-      const double q = std::log(d2 / d0);
-      ak2 = std::max(0.0, ((d2 - d0) * (a1 - a0) - (d1 - d0) * (a2 - a0)) / ((d2 - d0) * std::log(d1 / d0) - (d1 - d0) * q));
+      const double ln_d0 = std::log(d0);
+      const double q = ln_d2 - ln_d0;  // ln(d2 / d0)
+      ak2 = std::max(0.0, ((d2 - d0) * (a1 - a0) - (d1 - d0) * (a2 - a0)) / ((d2 - d0) * (std::log(d1) - ln_d0) - (d1 - d0) * q));
       fitted = aed >= 0.0 || ak2 > 0.0;
       if (fitted) {
         ak1 = (a2 - a0 - ak2 * q) / (d2 - d0);
@@ -415,8 +477,8 @@ Reference reference_attenuation(const Geometry& g, const Medium& m) {
       ak2 = 0.0;
       if (ak1 == 0.0) ak1 = emd;
     }
-    const double ael = a2 - ak1 * d2 - ak2 * std::log(d2);
-    out.aref = ael + ak1 * d + ak2 * std::log(d);
+    const double ael = a2 - ak1 * d2 - ak2 * ln_d2;
+    out.aref = ael + ak1 * d + (ak2 != 0.0 ? ak2 * std::log(d) : 0.0);
     out.mode = ItmMode::kLineOfSight;
   } else {
     // Beyond: the diffraction line, or the troposcatter line beyond the distance d_x where it
@@ -661,7 +723,7 @@ double ItmPath::delta_h(double x1, double x2) {
   if (x1 != dh_x1_ || x2 != dh_x2_) {
     dh_x1_ = x1;
     dh_x2_ = x2;
-    dh_value_ = delta_h_of(z_.data(), n_, xi_, x1, x2, dh_samples_);
+    dh_value_ = delta_h_of(z_.data(), n_, xi_, x1, x2, dh_scratch_);
   }
   return dh_value_;
 }
@@ -772,10 +834,11 @@ double height_gain_db(double x, double k) {
     if (k < 1e-5 || x * w * w * w > 5495.0) return x > 1.0 ? 17.372 * std::log(x) - 117.0 : -117.0;
     return 2.5e-5 * x * x / k - 8.686 * w - 15.0;
   }
-  double f = 0.05751 * x - 4.343 * std::log(x);
+  const double ln_x = std::log(x);
+  double f = 0.05751 * x - 4.343 * ln_x;
   if (x < 2000.0) {
     const double w = 0.0134 * x * std::exp(-0.005 * x);
-    f = (1.0 - w) * f + w * (17.372 * std::log(x) - 117.0);
+    f = (1.0 - w) * f + w * (17.372 * ln_x - 117.0);
   }
   return f;
 }
@@ -818,7 +881,7 @@ double inverse_normal(double q) {
 
 double delta_h(std::span<const double> ground_m, double spacing_m, double x1_m, double x2_m) {
   if (ground_m.size() < 2 || !(spacing_m > 0.0)) throw std::invalid_argument("delta_h: needs 2 samples and a spacing > 0");
-  std::vector<double> scratch;
+  DeltaHScratch scratch;
   return delta_h_of(ground_m.data(), static_cast<int>(ground_m.size()) - 1, spacing_m, x1_m, x2_m, scratch);
 }
 

@@ -10,6 +10,7 @@
 // one line naming the parameter and its range (check_itm()).
 #pragma once
 
+#include <cmath>
 #include <span>
 #include <string>
 #include <vector>
@@ -82,6 +83,13 @@ struct ItmLoss {
   double horizon_angle_rad[2] = {0, 0};  // elevation of each horizon ray
 };
 
+// Scratch space of the terrain irregularity: the resampled profile, and the last quantiles
+// found (a guess for the next, which only decides how fast they are found).
+struct DeltaHScratch {
+  std::vector<double> samples, gathered;
+  double lower = std::nan(""), upper = std::nan("");
+};
+
 // One path's terrain, to be evaluated for many receiver heights: what depends on the profile
 // and the transmitter alone is computed once (set_profile), each loss() then costs O(profile
 // length) at most. Holds scratch space: one per thread.
@@ -132,7 +140,7 @@ class ItmPath {
                                                         // transmitter
   // Delta h depends on the window (x1, x2) only: the last one is kept.
   double dh_x1_ = -1.0, dh_x2_ = -1.0, dh_value_ = 0.0;
-  std::vector<double> dh_samples_;
+  DeltaHScratch dh_scratch_;
 };
 
 // One path, one receiver height: ItmPath(frequency, parameters), set_profile(), loss().
