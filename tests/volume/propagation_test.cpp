@@ -47,6 +47,8 @@ std::pair<int, int> tx_column(const Volume& v, const Transmitter& tx) {
           static_cast<int>(std::lround((tx.lat - l.origin[1]) / l.spacing[1]))};
 }
 
+const Transmitter kFlatTx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+
 TEST(FreeSpace, MatchesTheTextbookFormula) {
   for (double f : {30.0, 144.0, 900.0, 2400.0, 10000.0}) {
     for (double d_km : {0.1, 1.0, 7.5, 20.0, 150.0}) {
@@ -196,54 +198,73 @@ TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
   EXPECT_NEAR(v.at(it, jt, 0), free_space_loss_db(1.0, 900.0), 1e-4);  // same point: clamped to 1 m
 }
 
-TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
+// Flat ground 100 m up, a transmitter 30 m above it, receivers at 2, 52 and 102 m, 25 km.
+RfResult flat_ground_volume(const RfOptions& options) {
   const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
   RfGrid grid;
   grid.radius_km = 25.0;
   grid.spacing_arcsec = 15.0;
   grid.heights_agl = {2.0, 52.0, 102.0};
-  const Volume v = compute_rf(flat, tx, grid).path_loss;
-  const auto [it, jt] = tx_column(v, tx);
+  return compute_rf(flat, kFlatTx, grid, options);
+}
+
+// The loss grows along the transmitter's row (east and west) and column (north) from `first`
+// lattice steps out. Beyond the radio horizon of 30 m and 2 m antennas (about 28 km at
+// k = 4/3) the far corner at 2 m is more than `excess` dB below free space, and higher
+// receivers see less loss.
+void expect_loss_grows_over_flat_ground(const Volume& v, int first, double excess) {
+  const auto [it, jt] = tx_column(v, kFlatTx);
   for (int k = 0; k < 3; ++k) {
-    for (int i = it + 1; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
-    for (int i = it - 1; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
-    for (int j = jt + 1; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
+    for (int i = it + first; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
+    for (int i = it - first; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
+    for (int j = jt + first; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
   }
-  // Beyond the radio horizon of 30 m and 2 m antennas (about 28 km at k = 4/3), the bulge
-  // diffracts: the far corner at 2 m is well below free space... and higher receivers see more.
   const int far = v.lattice.dims[0] - 1;
-  const double d = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
-  EXPECT_GT(v.at(far, 0, 0), free_space_loss_db(d, 900.0) + 6.0);
+  const double d = geodesic_m(kFlatTx.lat, kFlatTx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
+  EXPECT_GT(v.at(far, 0, 0), free_space_loss_db(d, 900.0) + excess);
   EXPECT_LT(v.at(far, 0, 2), v.at(far, 0, 0));
 }
 
-TEST(Rf, LossGrowsBehindARidge) {
-  // A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of the transmitter.
+TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
+  expect_loss_grows_over_flat_ground(flat_ground_volume(RfOptions{}).path_loss, 1, 6.0);
+}
+
+// A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of a transmitter 30 m up;
+// receivers at 10..810 m every 200 m, 12 km.
+Volume ridge_volume(const RfOptions& options) {
   const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
   RfGrid grid;
   grid.radius_km = 12.0;
   grid.spacing_arcsec = 30.0;
   grid.heights_agl = {10.0, 210.0, 410.0, 610.0, 810.0};
-  const Volume v = compute_rf(dem, tx, grid).path_loss;
+  return compute_rf(dem, kFlatTx, grid, options).path_loss;
+}
+
+// Deep shadow at the east edge, falling as the receiver rises out of it, and every column east
+// of the ridge in its shadow at 10 m.
+void expect_shadow_behind_the_ridge(const Volume& v) {
+  const Transmitter& tx = kFlatTx;
   const auto [it, jt] = tx_column(v, tx);
-  const int east = v.lattice.dims[0] - 1, west = 0;
+  const int east = v.lattice.dims[0] - 1;
   ASSERT_GT(v.lattice.world(0, east), 6.6);
   const double d_east = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, east));
-  const double d_west = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, west));
-  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);  // deep shadow
-  // The open side: the bulge of flat ground leaves about half a Fresnel zone of clearance at
-  // 12 km for 30 m and 10 m antennas, so the loss is close to free space.
-  EXPECT_NEAR(v.at(west, jt, 0), free_space_loss_db(std::hypot(d_west, 20.0), 900.0), 2.0);
-  // Behind the ridge the loss falls as the receiver rises out of the shadow.
+  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);
   for (int k = 1; k < 5; ++k) EXPECT_LT(v.at(east, jt, k), v.at(east, jt, k - 1)) << k;
-  // Every column east of the ridge at 10 m is in its shadow.
   for (int i = it; i < v.lattice.dims[0]; ++i) {
     if (v.lattice.world(0, i) <= 6.565) continue;
     const double d = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, i));
     EXPECT_GT(v.at(i, jt, 0), free_space_loss_db(d, 900.0) + 15.0) << i;
   }
+}
+
+TEST(Rf, LossGrowsBehindARidge) {
+  const Volume v = ridge_volume(RfOptions{});
+  expect_shadow_behind_the_ridge(v);
+  // The open side: the bulge of flat ground leaves about half a Fresnel zone of clearance at
+  // 12 km for 30 m and 10 m antennas, so the loss is close to free space.
+  const auto [it, jt] = tx_column(v, kFlatTx);
+  const double d_west = geodesic_m(kFlatTx.lat, kFlatTx.lon, kFlatTx.lat, v.lattice.world(0, 0));
+  EXPECT_NEAR(v.at(0, jt, 0), free_space_loss_db(std::hypot(d_west, 20.0), 900.0), 2.0);
 }
 
 TEST(Rf, SignalIsEirpMinusPathLoss) {
@@ -343,50 +364,15 @@ TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
 }
 
 TEST(RfItm, LossGrowsWithDistanceOverFlatGroundAndHasNoValueAtTheTransmitter) {
-  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
-  RfGrid grid;
-  grid.radius_km = 25.0;
-  grid.spacing_arcsec = 15.0;
-  grid.heights_agl = {2.0, 52.0, 102.0};
-  const RfResult r = compute_rf(flat, tx, grid, itm_options());
-  const Volume& v = r.path_loss;
-  const auto [it, jt] = tx_column(v, tx);
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_TRUE(std::isnan(v.at(it, jt, k)));
-    for (int i = it + 2; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
-    for (int i = it - 2; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
-    for (int j = jt + 2; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
-  }
-  // Beyond the radio horizon of 30 m and 2 m antennas (about 28 km), the far corner at 2 m is
-  // well below free space, and higher receivers see less loss.
-  const int far = v.lattice.dims[0] - 1;
-  const double d = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
-  EXPECT_GT(v.at(far, 0, 0), 32.45 + 20.0 * std::log10(900.0) + 20.0 * std::log10(d / 1000.0) + 10.0);
-  EXPECT_LT(v.at(far, 0, 2), v.at(far, 0, 0));
+  const RfResult r = flat_ground_volume(itm_options());
+  expect_loss_grows_over_flat_ground(r.path_loss, 2, 10.0);
+  const auto [it, jt] = tx_column(r.path_loss, kFlatTx);
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isnan(r.path_loss.at(it, jt, k)));
   ASSERT_FALSE(r.notes.empty());
   EXPECT_EQ(r.notes[0], "ITM has no value at the transmitter's own column (NaN)");
 }
 
-TEST(RfItm, LossGrowsBehindARidge) {
-  const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
-  RfGrid grid;
-  grid.radius_km = 12.0;
-  grid.spacing_arcsec = 30.0;
-  grid.heights_agl = {10.0, 210.0, 410.0, 610.0, 810.0};
-  const Volume v = compute_rf(dem, tx, grid, itm_options()).path_loss;
-  const auto [it, jt] = tx_column(v, tx);
-  const int east = v.lattice.dims[0] - 1;
-  const double d_east = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, east));
-  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);
-  for (int k = 1; k < 5; ++k) EXPECT_LT(v.at(east, jt, k), v.at(east, jt, k - 1)) << k;
-  for (int i = it; i < v.lattice.dims[0]; ++i) {
-    if (v.lattice.world(0, i) <= 6.565) continue;
-    const double d = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, i));
-    EXPECT_GT(v.at(i, jt, 0), free_space_loss_db(d, 900.0) + 15.0) << i;
-  }
-}
+TEST(RfItm, LossGrowsBehindARidge) { expect_shadow_behind_the_ridge(ridge_volume(itm_options())); }
 
 TEST(RfItm, RejectsParametersOutsideTheModelsRange) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
