@@ -48,6 +48,11 @@ struct RfCommandOptions {
   bool quiet = false;
 };
 
+// The options only one model takes.
+constexpr const char* kDeygoutOptions[] = {"--k-factor", "--edge-depth"};
+constexpr const char* kItmOptions[] = {"--polarization", "--permittivity", "--conductivity", "--refractivity", "--climate",
+                                       "--time", "--location", "--situation", "--mdvar"};
+
 bool given(const RfCommandOptions& o, const std::string& name) {
   return std::find(o.given.begin(), o.given.end(), name) != o.given.end();
 }
@@ -103,11 +108,10 @@ void run_rf(const RfCommandOptions& o) {
     throw std::runtime_error("--model " + o.model + ": must be itm or deygout");
   }
   const bool itm = options.model == volume::RfModel::kItm;
-  for (const char* name : {"--k-factor", "--edge-depth"}) {
+  for (const char* name : kDeygoutOptions) {
     if (itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model deygout");
   }
-  for (const char* name : {"--polarization", "--permittivity", "--conductivity", "--refractivity", "--climate", "--time",
-                           "--location", "--situation", "--mdvar"}) {
+  for (const char* name : kItmOptions) {
     if (!itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model itm");
   }
   volume::Transmitter tx = parse_tx(o.tx);
@@ -245,10 +249,10 @@ void add_rf_command(CLI::App& app) {
   cmd->add_flag("--force", o->force, "Replace an existing output file");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o, cmd] {
-    for (const char* name : {"--k-factor", "--edge-depth", "--polarization", "--permittivity", "--conductivity",
-                             "--refractivity", "--climate", "--time", "--location", "--situation", "--mdvar"}) {
+    for (const char* name : kDeygoutOptions)
       if (cmd->count(name) > 0) o->given.push_back(name);
-    }
+    for (const char* name : kItmOptions)
+      if (cmd->count(name) > 0) o->given.push_back(name);
     run_rf(*o);
   });
 }
