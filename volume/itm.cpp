@@ -37,12 +37,17 @@
 //     below zero are compressed, A (29 - A) / (29 - 10 A).
 //  Basic transmission loss = 32.45 + 20 log10(f / MHz) + 20 log10(d / km) + A.
 //
-// Where this departs from the usual driver code, it is for speed and gives the same values
-// (to rounding): the transmitter's steepest interior sample is found once per profile; the
-// receiver's per height, from precomputed terms; least-squares lines over the profile come from
-// prefix sums; Delta h is kept while its window does not change; troposcatter is evaluated only
-// for paths long enough that it could matter (beyond max(d_Ls, d_L + 0.3 X_ae ln(47.7 k)), the
-// least the crossover distance can be).
+// Where this departs from a plain transcription, it is for speed and gives the same values (to
+// rounding): the transmitter's steepest interior sample is found once per profile, the
+// receiver's from an upper envelope of its horizon lines built once per profile; least-squares
+// lines over the profile come from prefix sums; Delta h is kept while its window does not
+// change, and its quantiles are searched first among the values near the last ones found;
+// troposcatter is evaluated only for paths long enough that it could matter (beyond
+// max(d_Ls, d_L + 0.3 X_ae ln(47.7 k)), the least the crossover distance can be). One change
+// of substance, at rounding level: positions and counts within 1e-9 of a whole number are taken
+// as that number before the Algorithm rounds them (snap()), so that a path and its reverse
+// give the same loss; otherwise a window end at 0.9 of a horizon distance of ten samples falls
+// on either side of a sample depending on the direction of computation.
 //
 // Limits: the model's own (20 MHz - 20 GHz; paths of 1 - 2000 km; antennas 0.5 - 3000 m; it
 // reports "warning" 3 or 4 outside them, and still gives a number); a single profile stands
