@@ -65,6 +65,10 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace terravol::volume {
 
 namespace {
@@ -216,31 +220,29 @@ void fit_window(double x1, double x2, double xi, int n, int& ja, int& jb) {
   jb = static_cast<int>(b);
 }
 
-// The k-th smallest (0-based) of s, guided by a guess of it: a branch-free pass gathers the
-// values at or below a threshold a little above the guess (then, if too few, a little more);
-// when those are at least k + 1 and not too many, the answer is among them, else s is
-// searched whole. Exact either way; the
-// guess only decides how fast. Reorders s; scratch holds the gathered values.
-double kth_smallest(std::vector<double>& s, std::size_t k, double guess, double margin, std::vector<double>& scratch) {
-  const std::size_t n = s.size();
-  if (std::isfinite(guess) && margin > 0.0) {
-    scratch.resize(n);
-    for (const double threshold : {guess + margin, guess + 5.0 * margin}) {
-      std::size_t count = 0;
-      for (const double v : s) {
-        scratch[count] = v;
-        count += v <= threshold ? 1 : 0;
-      }
-      if (count > 4 * (k + 1)) break;
-      if (count > k) {
-        std::nth_element(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(k),
-                         scratch.begin() + static_cast<std::ptrdiff_t>(count));
-        return scratch[k];
-      }
+// The k-th smallest (0-based; kLargest: the k-th largest) of c[0..count), count > k,
+// reordering c. With few values beyond it, by taking the extreme off count - 1 - k times
+// (branch-free passes over a few dozen values); else std::nth_element.
+template <bool kLargest>
+double kth_extreme(double* c, std::size_t count, std::size_t k) {
+  std::size_t beyond = count - 1 - k;
+  if (beyond > 8) {
+    if constexpr (kLargest) {
+      std::nth_element(c, c + k, c + count, std::greater<double>());
+    } else {
+      std::nth_element(c, c + k, c + count);
     }
+    return c[k];
   }
-  std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(k), s.end());
-  return s[k];
+  for (;;) {
+    double top = c[0];
+    for (std::size_t i = 1; i < count; ++i) top = kLargest ? std::min(top, c[i]) : std::max(top, c[i]);
+    if (beyond == 0) return top;
+    std::size_t at = 0;
+    while (c[at] != top) ++at;
+    c[at] = c[--count];
+    --beyond;
+  }
 }
 
 double delta_h_of(const double* z, int np, double xi, double x1, double x2, DeltaHScratch& w) {
@@ -249,31 +251,119 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   if (span < 2.0) return 0.0;
   const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
   const int n = 10 * ka - 5;
-  std::vector<double>& s = w.samples;
-  s.resize(static_cast<std::size_t>(n));
-  // Linear interpolation at n equally spaced points from xa to xb; k walks along the profile
-  // (the interval ends at sample k, or the last one).
+  const auto size = static_cast<std::size_t>(n);
+  w.samples.resize(size);
+  w.low.resize(size);
+  w.high.resize(size);
+  double* s = w.samples.data();
+  // Linear interpolation at n equally spaced points p from xa to xb, each on the interval that
+  // ends at sample k = ceil(p), within [floor(xa) + 1, np] (p >= 0 here, so ceil(p) is the
+  // truncation plus one unless p is whole); the sums for the line, in order.
   const double step = (xb - xa) / (n - 1);
-  int k = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
-  double sum = 0.0, sum_i = 0.0;
-  for (int j = 0; j < n; ++j) {
-    const double p = xa + j * step;
-    while (p > k && k < np) ++k;
-    const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
-    s[static_cast<std::size_t>(j)] = v;
-    sum += v;
-    sum_i += j * v;
+  const int k0 = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
+  double sum = 0.0, sum_i = 0.0, jd = 0.0;
+  int j = 0;
+#if defined(__SSE2__)
+  // Two points at a time, with the same operations as the scalar loop below.
+  {
+    const __m128d xa2 = _mm_set1_pd(xa), step2 = _mm_set1_pd(step), one = _mm_set1_pd(1.0);
+    const __m128d two = _mm_set1_pd(2.0), lo = _mm_set1_pd(k0), hi = _mm_set1_pd(np);
+    __m128d j2 = _mm_set_pd(1.0, 0.0);
+    for (; j + 1 < n; j += 2, j2 = _mm_add_pd(j2, two)) {
+      const __m128d p = _mm_add_pd(xa2, _mm_mul_pd(j2, step2));
+      __m128d k = _mm_cvtepi32_pd(_mm_cvttpd_epi32(p));
+      k = _mm_add_pd(k, _mm_and_pd(_mm_cmplt_pd(k, p), one));
+      k = _mm_min_pd(hi, _mm_max_pd(lo, k));
+      const __m128i ki = _mm_cvttpd_epi32(k);
+      const int ka0 = _mm_cvtsi128_si32(ki), ka1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(ki, 1));
+      const __m128d zk = _mm_loadh_pd(_mm_load_sd(z + ka0), z + ka1);
+      const __m128d zm = _mm_loadh_pd(_mm_load_sd(z + ka0 - 1), z + ka1 - 1);
+      const __m128d v = _mm_add_pd(zk, _mm_mul_pd(_mm_sub_pd(zk, zm), _mm_sub_pd(p, k)));
+      _mm_storeu_pd(s + j, v);
+      const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
+      sum += v0;
+      sum_i += jd * v0;
+      jd += 1.0;
+      sum += v1;
+      sum_i += jd * v1;
+      jd += 1.0;
+    }
   }
-  const Line line = trapezoid_fit(sum, sum_i, s.front(), s.back(), 0, n - 1);
-  const double at0 = line.at(0.0);
-  for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] -= at0 + line.slope * j;
-  // The ka-th smallest and the ka-th largest (the smallest of the negated values), guided by
-  // the last ones found.
+#endif
+  for (; j < n; ++j, jd += 1.0) {
+    const double p = xa + j * step;
+    int k = static_cast<int>(p);
+    k += k < p ? 1 : 0;
+    k = std::min(np, std::max(k0, k));
+    const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
+    s[j] = v;
+    sum += v;
+    sum_i += jd * v;
+  }
+  const Line line = trapezoid_fit(sum, sum_i, s[0], s[n - 1], 0, n - 1);
+  const double at0 = line.at(0.0), slope = line.slope;
+  // The ka-th smallest and the ka-th largest deviation from the line. Their candidates are
+  // gathered in the same pass: the deviations beyond thresholds a little inside the last ones
+  // found; when too few, again with thresholds 4, 16 and 64 times farther in, then all. Exact
+  // whatever the guess: it only decides how much is gathered. Deviation i is
+  // s[i] - (at0 + slope i), computed alike wherever it is needed.
   const auto rank = static_cast<std::size_t>(ka - 1);
-  const double margin = 0.02 * (w.upper - w.lower);
-  const double lower = kth_smallest(s, rank, w.lower, margin, w.gathered);
-  for (double& v : s) v = -v;
-  const double upper = -kth_smallest(s, rank, -w.upper, margin, w.gathered);
+  const bool guessed = std::isfinite(w.lower) && std::isfinite(w.upper) && w.upper > w.lower;
+  const double margin = guessed ? 0.02 * (w.upper - w.lower) : 0.0;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double* low = w.low.data();
+  double* high = w.high.data();
+  std::size_t n_low = 0, n_high = 0;
+  if (guessed) {
+    const double low_threshold = w.lower + margin, high_threshold = w.upper - margin;
+    int i = 0;
+#if defined(__SSE2__)
+    {
+      const __m128d at2 = _mm_set1_pd(at0), slope2 = _mm_set1_pd(slope), two = _mm_set1_pd(2.0);
+      const __m128d lt = _mm_set1_pd(low_threshold), ht = _mm_set1_pd(high_threshold);
+      __m128d i2 = _mm_set_pd(1.0, 0.0);
+      for (; i + 1 < n; i += 2, i2 = _mm_add_pd(i2, two)) {
+        const __m128d r = _mm_sub_pd(_mm_loadu_pd(s + i), _mm_add_pd(at2, _mm_mul_pd(slope2, i2)));
+        const int below = _mm_movemask_pd(_mm_cmple_pd(r, lt)), above = _mm_movemask_pd(_mm_cmpge_pd(r, ht));
+        const double r0 = _mm_cvtsd_f64(r), r1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
+        low[n_low] = r0;
+        n_low += static_cast<std::size_t>(below & 1);
+        low[n_low] = r1;
+        n_low += static_cast<std::size_t>(below >> 1);
+        high[n_high] = r0;
+        n_high += static_cast<std::size_t>(above & 1);
+        high[n_high] = r1;
+        n_high += static_cast<std::size_t>(above >> 1);
+      }
+    }
+#endif
+    for (double id = i; i < n; ++i, id += 1.0) {
+      const double r = s[i] - (at0 + slope * id);
+      low[n_low] = r;
+      n_low += r <= low_threshold ? 1 : 0;
+      high[n_high] = r;
+      n_high += r >= high_threshold ? 1 : 0;
+    }
+  }
+  // One side again, below threshold (sign 1) or above it (sign -1); everything when not finite.
+  auto regather = [&](double* c, double sign, double threshold) {
+    std::size_t count = 0;
+    double id = 0.0;
+    for (int i = 0; i < n; ++i, id += 1.0) {
+      const double r = s[i] - (at0 + slope * id);
+      c[count] = r;
+      count += sign * r <= sign * threshold ? 1 : 0;
+    }
+    return count;
+  };
+  for (double widen = 4.0; widen <= 64.0 && guessed; widen *= 4.0) {
+    if (n_low <= rank) n_low = regather(low, 1.0, w.lower + widen * margin);
+    if (n_high <= rank) n_high = regather(high, -1.0, w.upper - widen * margin);
+  }
+  if (n_low <= rank) n_low = regather(low, 1.0, kInf);
+  if (n_high <= rank) n_high = regather(high, -1.0, -kInf);
+  const double lower = kth_extreme<false>(low, n_low, rank);
+  const double upper = kth_extreme<true>(high, n_high, rank);
   w.lower = lower;
   w.upper = upper;
   return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));

@@ -86,7 +86,7 @@ struct ItmLoss {
 // Scratch space of the terrain irregularity: the resampled profile, and the last quantiles
 // found (a guess for the next, which only decides how fast they are found).
 struct DeltaHScratch {
-  std::vector<double> samples, gathered;
+  std::vector<double> samples, low, high;
   double lower = std::nan(""), upper = std::nan("");
 };
 
