@@ -132,6 +132,8 @@ constexpr Climate kClimates[7] = {
      {8.43, 8.19, 136.2e3, 188.5e3, 122.9e3}, 1.518, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
 };
 
+using itm_detail::TerminalTerms;
+
 // What the preparatory stage hands to the reference attenuation: the path length, the
 // antennas' structural and effective heights, the horizon distances and elevation angles, and
 // the terrain irregularity. Index 0 is the transmitter.
@@ -139,6 +141,7 @@ struct Geometry {
   double dist = 0.0;
   double hg[2] = {0, 0}, he[2] = {0, 0}, dl[2] = {0, 0}, the[2] = {0, 0};
   double dh = 0.0;
+  TerminalTerms terms[2];
 };
 
 struct Medium {
@@ -369,6 +372,18 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
+TerminalTerms terminal_terms(double dl, double he, const Medium& m) {
+  TerminalTerms t;
+  t.dls = std::sqrt(2.0 * he / m.gme);
+  const double a = 0.5 * dl * dl / he;  // the horizon's radius
+  const double wa = cube_root(a * m.wn);
+  const double pk = m.inverse_abs_zg / wa;
+  t.x = (1.607 - pk) * 151.0 * wa * dl / a;
+  t.gain_db = itm_functions::height_gain_db(t.x, pk);
+  t.dexa = std::sqrt(18e6 * he);
+  return t;
+}
+
 // The diffraction attenuation A_diff(d) (4.11) for one geometry: with the weight w, the
 // rounded-Earth (three radii) value A_r and the double knife edge A_k, w A_r + (1 - w) A_k + A_fo.
 class Diffraction {
@@ -381,13 +396,9 @@ class Diffraction {
     xd1_ = dla + tha / m.gme;
     afo_ = std::min(15.0, 2.171 * std::log(1.0 + 4.77e-4 * hgg * m.wn * sigma_h(delta_h_over(dlsa, g.dh))));
     qk_ = m.inverse_abs_zg;
-    for (int j = 0; j < 2; ++j) {
-      const double a = 0.5 * g.dl[j] * g.dl[j] / g.he[j];  // the horizon's radius
-      const double wa = cube_root(a * m.wn);
-      const double pk = qk_ / wa;
-      const double x = (1.607 - pk) * 151.0 * wa * g.dl[j] / a;
-      xht_ += x;
-      aht_ += itm_functions::height_gain_db(x, pk);
+    for (const TerminalTerms& t : g.terms) {
+      xht_ += t.x;
+      aht_ += t.gain_db;
     }
   }
 
@@ -509,8 +520,7 @@ struct Reference {
 Reference reference_attenuation(const Geometry& g, const Medium& m) {
   Reference out;
   int& w = out.warning;
-  double dls[2];
-  for (int j = 0; j < 2; ++j) dls[j] = std::sqrt(2.0 * g.he[j] / m.gme);  // smooth-Earth horizons
+  const double dls[2] = {g.terms[0].dls, g.terms[1].dls};  // smooth-Earth horizons
   const double dlsa = dls[0] + dls[1], dla = g.dl[0] + g.dl[1];
   const double tha = std::max(g.the[0] + g.the[1], -dla * m.gme);
 
@@ -612,7 +622,7 @@ double variability(double aref, const Geometry& g, const Medium& m, const Statis
   const double gm = st.g_minus, gp = st.g_plus;
   // The effective distance d_e: 130 km at the sum of the smooth-Earth horizons plus a
   // frequency term, proportional before it and growing one for one after.
-  const double dexa = std::sqrt(18e6 * g.he[0]) + std::sqrt(18e6 * g.he[1]) + st.dexa_frequency_m;
+  const double dexa = g.terms[0].dexa + g.terms[1].dexa + st.dexa_frequency_m;
   const double de = g.dist < dexa ? 130e3 * g.dist / dexa : 130e3 + g.dist - dexa;
   const double vmd = c.median(de);
   const double sgtm = c.sigma_minus(de) * gm, sgtp = c.sigma_plus(de) * gp;
@@ -774,6 +784,7 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
     rx_u_[static_cast<std::size_t>(i)] = 1.0 / sb;
   }
   dh_x1_ = dh_x2_ = -1.0;
+  tx_terms_dl_ = tx_terms_he_ = -1.0;
   rx_hull_built_ = false;
   xae_ = std::cbrt(1.0 / (wn_ * gme_ * gme_));
 }
@@ -858,6 +869,24 @@ ItmLoss ItmPath::loss(double rx_height_m) {
     const auto a = static_cast<std::size_t>(ja), b = static_cast<std::size_t>(jb);
     return trapezoid_fit(sum_z_[b + 1] - sum_z_[a], sum_iz_[b + 1] - sum_iz_[a], z_[a], z_[b], ja, jb);
   };
+  Medium m;
+  m.wn = wn_;
+  m.ens = ns_;
+  m.gme = gme_;
+  m.zg = Complex(zg_re_, zg_im_);
+  m.inverse_abs_zg = inverse_abs_zg_;
+  m.xae = xae_;
+  // The terminal terms once the horizon distances and effective heights are final; the
+  // transmitter's from the last receiver's when those are the same.
+  auto set_terms = [&] {
+    if (g.dl[0] != tx_terms_dl_ || g.he[0] != tx_terms_he_) {
+      tx_terms_ = terminal_terms(g.dl[0], g.he[0], m);
+      tx_terms_dl_ = g.dl[0];
+      tx_terms_he_ = g.he[0];
+    }
+    g.terms[0] = tx_terms_;
+    g.terms[1] = terminal_terms(g.dl[1], g.he[1], m);
+  };
   auto horizon = [&](double he) { return std::sqrt(2.0 * he / gme_) * std::exp(-0.07 * std::sqrt(g.dh / std::max(he, 5.0))); };
   const double z_first = z_[0], z_last = z_[static_cast<std::size_t>(n_)];
   if (g.dl[0] + g.dl[1] > 1.5 * dist_) {
@@ -873,22 +902,17 @@ ItmLoss ItmPath::loss(double rx_height_m) {
         g.dl[j] = horizon(g.he[j]);
       }
     }
+    set_terms();
     for (int j = 0; j < 2; ++j) {
-      const double q = std::sqrt(2.0 * g.he[j] / gme_);
+      const double q = g.terms[j].dls;  // sqrt(2 h_e / gamma_e)
       g.the[j] = (0.65 * g.dh * (q / g.dl[j] - 1.0) - 2.0 * g.he[j]) / q;
     }
   } else {
     g.he[0] = g.hg[0] + std::max(z_first - fit(xl0, 0.9 * g.dl[0]).at(0), 0.0);
     g.he[1] = g.hg[1] + std::max(z_last - fit(dist_ - 0.9 * g.dl[1], xl1).at(n_), 0.0);
+    set_terms();
   }
 
-  Medium m;
-  m.wn = wn_;
-  m.ens = ns_;
-  m.gme = gme_;
-  m.zg = Complex(zg_re_, zg_im_);
-  m.inverse_abs_zg = inverse_abs_zg_;
-  m.xae = xae_;
   const Reference ref = reference_attenuation(g, m);
 
   ItmLoss out;

@@ -90,6 +90,17 @@ struct DeltaHScratch {
   double lower = std::nan(""), upper = std::nan("");
 };
 
+namespace itm_detail {
+// What the reference attenuation and the statistics take from one terminal's horizon distance
+// d_L and effective height h_e alone (ItmPath keeps the transmitter's while they stay).
+struct TerminalTerms {
+  double dls = 0.0;      // the smooth-Earth horizon distance sqrt(2 h_e / gamma_e)
+  double x = 0.0;        // the horizon's part of the rounded-Earth diffraction distance (4.20)
+  double gain_db = 0.0;  // the height-gain F(x, K) of that part
+  double dexa = 0.0;     // sqrt(18e6 m h_e), the terminal's part of d_e's scale
+};
+}  // namespace itm_detail
+
 // One path's terrain, to be evaluated for many receiver heights: what depends on the profile
 // and the transmitter alone is computed once (set_profile), each loss() then costs O(profile
 // length) at most. Holds scratch space: one per thread.
@@ -138,6 +149,10 @@ class ItmPath {
   double xae_ = 0.0;  // (k gamma_e^2)^(-1/3), the diffraction's distance scale
   double tx_best_angle_ = 0.0, tx_best_distance_ = 0.0;  // steepest interior sample from the
                                                         // transmitter
+  // The transmitter's terminal terms depend on its horizon distance and effective height
+  // only: the last ones are kept (key dl < 0: none yet).
+  double tx_terms_dl_ = -1.0, tx_terms_he_ = -1.0;
+  itm_detail::TerminalTerms tx_terms_;
   // Delta h depends on the window (x1, x2) only: the last one is kept.
   double dh_x1_ = -1.0, dh_x2_ = -1.0, dh_value_ = 0.0;
   DeltaHScratch dh_scratch_;
