@@ -237,9 +237,15 @@ double kth_extreme(double* c, std::size_t count, std::size_t k) {
     }
     return c[k];
   }
+  auto extreme = [](double a, double b) { return kLargest ? std::min(a, b) : std::max(a, b); };
   for (;;) {
-    double top = c[0];
-    for (std::size_t i = 1; i < count; ++i) top = kLargest ? std::min(top, c[i]) : std::max(top, c[i]);
+    // Two running extremes (exact in any order), then the first place of it.
+    double top = c[0], top2 = c[count - 1];
+    for (std::size_t i = 1; i + 1 < count; i += 2) {
+      top = extreme(top, c[i]);
+      top2 = extreme(top2, c[i + 1]);
+    }
+    top = extreme(top, top2);
     if (beyond == 0) return top;
     std::size_t at = 0;
     while (c[at] != top) ++at;
