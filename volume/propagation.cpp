@@ -121,13 +121,17 @@ double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool
 
 double wavelength(double frequency_mhz) { return kSpeedOfLight / (frequency_mhz * 1e6); }
 
-// Bilinear height of a geographic grid at (lat, lon), clamped to its edges.
+// Bilinear height of a geographic grid at (lat, lon), clamped to its edges; at() takes the
+// position in the grid's (fractional) column and row instead.
 class DemSampler {
  public:
   explicit DemSampler(const io::Grid& g) : g_(g) {}
-  double operator()(double lat, double lon) const {
-    const double c = std::clamp((lon - g_.georef.x0) / g_.georef.dx, 0.0, static_cast<double>(g_.cols - 1));
-    const double r = std::clamp((g_.georef.y0 - lat) / g_.georef.dy, 0.0, static_cast<double>(g_.rows - 1));
+  double column(double lon) const { return (lon - g_.georef.x0) / g_.georef.dx; }
+  double row(double lat) const { return (g_.georef.y0 - lat) / g_.georef.dy; }
+  double operator()(double lat, double lon) const { return at(column(lon), row(lat)); }
+  double at(double column, double row) const {
+    const double c = std::clamp(column, 0.0, static_cast<double>(g_.cols - 1));
+    const double r = std::clamp(row, 0.0, static_cast<double>(g_.rows - 1));
     const int c0 = std::min(static_cast<int>(c), g_.cols - 2), r0 = std::min(static_cast<int>(r), g_.rows - 2);
     const double fc = c - c0, fr = r - r0;
     const float* row0 = &g_.heights[g_.index(r0, c0)];
@@ -241,10 +245,11 @@ void sample_profile(const io::Grid& dem, double tx_lat, double tx_lon, double rx
   out.distance_m = distance;
   out.ground_m.resize(static_cast<std::size_t>(segments) + 1);
   out.ground_m[0] = ground(tx_lat, tx_lon);
-  for (int m = 1; m < segments; ++m) {
-    const double t = static_cast<double>(m) / segments;
-    out.ground_m[static_cast<std::size_t>(m)] = ground(tx_lat + t * (rx_lat - tx_lat), tx_lon + t * (rx_lon - tx_lon));
-  }
+  // Along the line the grid position is affine in the sample index: stepped from the
+  // transmitter's (the same points to rounding, without two divisions per sample).
+  const double c_tx = ground.column(tx_lon), r_tx = ground.row(tx_lat);
+  const double dc = (ground.column(rx_lon) - c_tx) / segments, dr = (ground.row(rx_lat) - r_tx) / segments;
+  for (int m = 1; m < segments; ++m) out.ground_m[static_cast<std::size_t>(m)] = ground.at(c_tx + m * dc, r_tx + m * dr);
   out.ground_m[static_cast<std::size_t>(segments)] = ground(rx_lat, rx_lon);
 }
 
