@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -130,8 +131,8 @@ TEST(SplatCli, RunsSplatOnTheUtahTilesImportsItsOutputAndCompares) {
   EXPECT_GT(pearson, 0.5) << cmp.out;
 }
 
-// SPLAT!'s own ITM (-olditm) against the built-in one on the same 3" lattice, on a small disc
-// every run. docs/rf-model.md has the 20 km, 31-height comparison (r >= 0.98 at every height).
+// SPLAT!'s own ITM (-olditm) against the built-in one on SPLAT!'s own profiles (--check-itm)
+// and on the same 3" lattice, on a small disc every run. docs/rf-model.md has the 20 km, 31-height comparison (r >= 0.98 at every height).
 // Within 8 km a larger share of the points is near the transmitter, where SPLAT! evaluates
 // each point's path one sample short (6 dB at two samples out), so the correlation is lower.
 TEST(SplatCli, OldItmAgreesWithTheBuiltInItm) {
@@ -142,9 +143,28 @@ TEST(SplatCli, OldItmAgreesWithTheBuiltInItm) {
   test::TempDir dir;
   const auto splat = dir.path() / "splat.vdb", itm = dir.path() / "itm.vdb";
   const std::string common = " --quiet --tx 40.76,-111.89,30,900 --heights 10:60:50 --radius-km 8 -o ";
-  const auto rs = run_terravol("splat-volume --olditm --sdf " + tiles.string() + common + splat.string());
+  const auto rs = run_terravol("splat-volume --olditm --check-itm --sdf " + tiles.string() + common + splat.string());
   ASSERT_EQ(rs.status, 0) << rs.err;
   EXPECT_NE(read_volume(splat).attributes.at("model").find("(ITM)"), std::string::npos);
+  // On SPLAT!'s own profiles (--check-itm) the two ITMs give the same values to SPLAT!'s two
+  // decimals, at nearly every point SPLAT! wrote.
+  for (const char* height : {"profiles, 10 m: ", "profiles, 60 m: "}) {
+    const auto at = rs.out.find(height);
+    ASSERT_NE(at, std::string::npos) << rs.out;
+    std::size_t reproduced = 0, reported = 0, elsewhere = 0;
+    double pearson = 0, median = 0, median_abs = 0;
+    ASSERT_EQ(std::sscanf(rs.out.c_str() + at + std::strlen(height),
+                          "%zu of %zu points reproduced (%zu computed elsewhere); r %lf, median SPLAT! - ITM %lf dB, "
+                          "median |difference| %lf dB",
+                          &reproduced, &reported, &elsewhere, &pearson, &median, &median_abs),
+              6)
+        << rs.out;
+    EXPECT_GT(reported, 30000u) << rs.out;
+    EXPECT_GE(reproduced, reported - reported / 1000) << rs.out;
+    EXPECT_GE(pearson, 0.9999) << rs.out;
+    EXPECT_LE(median_abs, 0.005) << rs.out;
+    EXPECT_LE(std::abs(median), 0.003) << rs.out;
+  }
   const auto ri = run_terravol("rf --model itm --spacing 3 --dem " + tiles.string() + common + itm.string());
   ASSERT_EQ(ri.status, 0) << ri.err;
   const auto cmp = run_terravol("compare-volumes " + itm.string() + " " + splat.string());
@@ -202,6 +222,8 @@ TEST(SplatCli, BadOptionsFailWithOneLine) {
       {" --import " + bad_ano.string() + sdf + " --heights 10" + out,
        "--sdf " + tiles.string() + ": not used with --import"},
       {" --import " + bad_ano.string() + " --olditm --heights 10" + out, "--olditm: not used with --import"},
+      {" --import " + bad_ano.string() + " --check-itm --heights 10" + out, "--check-itm: needs a SPLAT! run with --olditm"},
+      {t + sdf + " --check-itm" + out, "--check-itm: needs a SPLAT! run with --olditm (not --import)"},
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);
