@@ -404,7 +404,19 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
   std::vector<double> heights_m(static_cast<std::size_t>(nh));
   for (int k = 0; k < nh; ++k) heights_m[static_cast<std::size_t>(k)] = l.world(2, k);
 
-  std::atomic<std::size_t> done{0}, samples{0}, warned{0};
+  // The disc: decided from the flat distance in the transmitter's frame where that is clearly
+  // inside or outside (it is within 0.5% of the geodesic one over 500 km), by the geodesic
+  // near the rim.
+  auto outside_disc = [&](double lat, double lon) {
+    if (!grid.disc) return false;
+    const double flat = std::hypot((lon - tx.lon) * mlon, (lat - tx.lat) * mlat);
+    if (flat < 0.99 * radius_m) return false;
+    if (flat > 1.01 * radius_m) return true;
+    double distance = 0.0;
+    GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, lat, lon, distance);
+    return distance > radius_m;
+  };
+  std::atomic<std::size_t> done{0}, samples{0}, warned{0}, computed{0};
   std::mutex progress_mutex;
   int reported = -1;
   const auto t0 = std::chrono::steady_clock::now();
@@ -412,10 +424,15 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     ColumnModel model(tx, options);
     TerrainProfile profile;
     std::vector<float> column(static_cast<std::size_t>(nh));
-    std::size_t local_samples = 0, local_warned = 0;
+    std::size_t local_samples = 0, local_warned = 0, local_computed = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const int i = static_cast<int>(c % static_cast<std::size_t>(l.dims[0]));
       const int j = static_cast<int>(c / static_cast<std::size_t>(l.dims[0]));
+      if (outside_disc(l.world(1, j), l.world(0, i))) {
+        for (int k = 0; k < nh; ++k) loss.values[c + layer * static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      ++local_computed;
       sample_profile(dem, tx.lat, tx.lon, l.world(1, j), l.world(0, i), step_m, profile);
       local_samples += profile.ground_m.size() - 2;
       local_warned += model.path_loss(profile, heights_m, column);
@@ -423,6 +440,7 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     }
     samples += local_samples;
     warned += local_warned;
+    computed += local_computed;
     const std::size_t now = done += r.size();
     if (options.progress) {
       const int percent = static_cast<int>(100.0 * static_cast<double>(now) / static_cast<double>(n_columns));
@@ -434,8 +452,13 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     }
   });
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  result.columns = n_columns;
-  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(n_columns);
+  result.columns = computed.load();
+  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(std::max<std::size_t>(1, computed.load()));
+  if (grid.disc) {
+    result.notes.push_back("the " + std::to_string(n_columns - computed.load()) + " columns farther than " +
+                           num(grid.radius_km) + " km from the transmitter are NaN (disc)");
+    loss.attributes["disc_radius_km"] = num(grid.radius_km);
+  }
   if (options.model == RfModel::kItm) {
     result.notes.push_back("ITM has no value at the transmitter's own column (NaN)");
     if (warned > 0) {

@@ -36,6 +36,9 @@ struct RfGrid {
                                      // 2000 (ITM: 10, 60, ..., 2010)
   double spacing_arcsec = 0.0;       // lattice spacing in latitude and in longitude, arc seconds;
                                      // 0: default_spacing_arcsec()
+  // Only the columns within radius_km of the transmitter (WGS84 geodesic) are computed, the
+  // box's corners are NaN: the disc SPLAT! computes (its -R), at 79% of the box's cost.
+  bool disc = false;
 };
 
 enum class RfModel {

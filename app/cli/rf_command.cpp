@@ -42,6 +42,7 @@ struct RfCommandOptions {
   std::filesystem::path output;
   double radius_km = 20.0;
   double spacing_arcsec = 0.0;
+  bool disc = false;
   double k_factor = 4.0 / 3.0;
   int edge_depth = 2;
   bool force = false;
@@ -134,6 +135,7 @@ void run_rf(const RfCommandOptions& o) {
   }
   grid.radius_km = o.radius_km;
   grid.spacing_arcsec = o.spacing_arcsec;
+  grid.disc = o.disc;
   if (!(o.radius_km > 0.0 && o.radius_km <= 500.0)) {
     throw std::runtime_error("--radius-km " + fmt(o.radius_km) + ": must be within (0, 500]");
   }
@@ -225,6 +227,9 @@ void add_rf_command(CLI::App& app) {
   cmd->add_option("--spacing", o->spacing_arcsec,
                   "Lattice spacing in latitude and longitude, arc seconds (default: a multiple of the DEM's "
                   "spacing giving at most 256 intervals across the box)");
+  cmd->add_flag("--disc", o->disc,
+                "Compute only the columns within --radius-km of the transmitter (the box's corners are "
+                "NaN): the disc SPLAT! computes");
   cmd->add_option("--k-factor", o->k_factor, "Deygout: effective Earth radius factor")->capture_default_str();
   cmd->add_option("--edge-depth", o->edge_depth,
                   "Deygout: recursion levels (1: principal edge only; 2: plus one secondary edge each side)")

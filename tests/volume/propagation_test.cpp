@@ -363,6 +363,43 @@ TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
   }
 }
 
+TEST(Rf, DiscLeavesTheColumnsBeyondTheRadiusNaNAndTheOthersAsTheBox) {
+  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
+  const Transmitter tx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+  RfGrid grid;
+  grid.radius_km = 5.0;
+  grid.spacing_arcsec = 15.0;
+  grid.heights_agl = {2.0, 52.0};
+  for (const RfModel model : {RfModel::kDeygout, RfModel::kItm}) {
+    RfOptions o;
+    o.model = model;
+    const RfResult box = compute_rf(dem, tx, grid, o);
+    grid.disc = true;
+    const RfResult disc = compute_rf(dem, tx, grid, o);
+    grid.disc = false;
+    const Lattice& l = box.path_loss.lattice;
+    ASSERT_EQ(disc.path_loss.lattice.dims, l.dims);
+    std::size_t inside = 0;
+    for (int j = 0; j < l.dims[1]; ++j)
+      for (int i = 0; i < l.dims[0]; ++i) {
+        const bool in = geodesic_m(tx.lat, tx.lon, l.world(1, j), l.world(0, i)) <= 5000.0;
+        inside += in;
+        for (int k = 0; k < 2; ++k) {
+          if (in) {
+            ASSERT_EQ(std::isnan(disc.path_loss.at(i, j, k)), std::isnan(box.path_loss.at(i, j, k)));
+            if (!std::isnan(box.path_loss.at(i, j, k))) {
+              ASSERT_EQ(disc.path_loss.at(i, j, k), box.path_loss.at(i, j, k));
+            }
+          } else {
+            ASSERT_TRUE(std::isnan(disc.path_loss.at(i, j, k))) << i << " " << j;
+          }
+        }
+      }
+    EXPECT_EQ(disc.columns, inside);
+    EXPECT_NEAR(static_cast<double>(inside) / static_cast<double>(l.dims[0] * l.dims[1]), M_PI / 4.0, 0.03);
+  }
+}
+
 TEST(RfItm, LossGrowsWithDistanceOverFlatGroundAndHasNoValueAtTheTransmitter) {
   const RfResult r = flat_ground_volume(itm_options());
   expect_loss_grows_over_flat_ground(r.path_loss, 2, 10.0);
