@@ -336,9 +336,15 @@ RfOptions itm_options() {
   return o;
 }
 
+// Rolling hills of +-250 m, and a transmitter 20 m above them at 450 MHz.
+io::Grid hilly_dem() {
+  return synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
+}
+const Transmitter kHillyTx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+
 TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
-  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
-  const Transmitter tx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
   RfGrid grid;
   grid.radius_km = 6.0;
   grid.spacing_arcsec = 30.0;
@@ -364,8 +370,8 @@ TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
 }
 
 TEST(Rf, DiscLeavesTheColumnsBeyondTheRadiusNaNAndTheOthersAsTheBox) {
-  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
-  const Transmitter tx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
   RfGrid grid;
   grid.radius_km = 5.0;
   grid.spacing_arcsec = 15.0;
