@@ -42,6 +42,10 @@
 //    transmitter. The slant distance is clamped to 1 m.
 //  - The line in latitude and longitude departs from the geodesic by metres over tens of km,
 //    far less than a DEM sample.
+//
+// With RfModel::kItm the same profile goes to the Longley-Rice model instead (volume/itm.h,
+// whose effective Earth comes from the surface refractivity): the profile without the bulge,
+// the antennas' heights above the ground at its ends, basic transmission loss out.
 #include "volume/propagation.h"
 
 #include <GeographicLib/Geodesic.hpp>
@@ -55,6 +59,7 @@
 #include <cstdio>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "io/scene_frame.h"
@@ -116,13 +121,17 @@ double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool
 
 double wavelength(double frequency_mhz) { return kSpeedOfLight / (frequency_mhz * 1e6); }
 
-// Bilinear height of a geographic grid at (lat, lon), clamped to its edges.
+// Bilinear height of a geographic grid at (lat, lon), clamped to its edges; at() takes the
+// position in the grid's (fractional) column and row instead.
 class DemSampler {
  public:
   explicit DemSampler(const io::Grid& g) : g_(g) {}
-  double operator()(double lat, double lon) const {
-    const double c = std::clamp((lon - g_.georef.x0) / g_.georef.dx, 0.0, static_cast<double>(g_.cols - 1));
-    const double r = std::clamp((g_.georef.y0 - lat) / g_.georef.dy, 0.0, static_cast<double>(g_.rows - 1));
+  double column(double lon) const { return (lon - g_.georef.x0) / g_.georef.dx; }
+  double row(double lat) const { return (g_.georef.y0 - lat) / g_.georef.dy; }
+  double operator()(double lat, double lon) const { return at(column(lon), row(lat)); }
+  double at(double column, double row) const {
+    const double c = std::clamp(column, 0.0, static_cast<double>(g_.cols - 1));
+    const double r = std::clamp(row, 0.0, static_cast<double>(g_.rows - 1));
     const int c0 = std::min(static_cast<int>(c), g_.cols - 2), r0 = std::min(static_cast<int>(r), g_.rows - 2);
     const double fc = c - c0, fr = r - r0;
     const float* row0 = &g_.heights[g_.index(r0, c0)];
@@ -136,8 +145,12 @@ class DemSampler {
   const io::Grid& g_;
 };
 
-void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
-  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+constexpr double kItmMinHeight = 0.5, kItmMaxHeight = 3000.0;  // the Algorithm's antenna limits
+
+void bad(const std::string& what) { throw std::invalid_argument(what); }
+
+// The transmitter and the model's options.
+void check_model(const Transmitter& tx, const RfOptions& options) {
   if (!std::isfinite(tx.lat) || std::abs(tx.lat) > 85.0) bad("transmitter latitude " + num(tx.lat) + ": must be within [-85, 85]");
   if (!std::isfinite(tx.lon) || std::abs(tx.lon) > 360.0) bad("transmitter longitude " + num(tx.lon) + ": must be within [-360, 360]");
   if (!std::isfinite(tx.height_agl) || tx.height_agl < 0.0 || tx.height_agl > 100000.0) {
@@ -149,6 +162,18 @@ void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions
   if (tx.erp_w && (!std::isfinite(*tx.erp_w) || *tx.erp_w <= 0.0 || *tx.erp_w > 1e9)) {
     bad("ERP " + num(*tx.erp_w) + ": must be within (0, 1e9] W");
   }
+  if (!std::isfinite(options.k_factor) || options.k_factor <= 0.0) bad("k-factor " + num(options.k_factor) + ": must be > 0");
+  if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
+  if (options.model == RfModel::kItm) {
+    check_itm(tx.frequency_mhz, options.itm);
+    if (tx.height_agl < kItmMinHeight || tx.height_agl > kItmMaxHeight) {
+      bad("transmitter height " + num(tx.height_agl) + ": ITM takes antenna heights within [0.5, 3000] m above ground");
+    }
+  }
+}
+
+// The receiver lattice, for that model.
+void check_grid(const RfGrid& grid, const RfOptions& options) {
   if (!std::isfinite(grid.radius_km) || grid.radius_km <= 0.0 || grid.radius_km > 500.0) {
     bad("radius " + num(grid.radius_km) + ": must be within (0, 500] km");
   }
@@ -158,16 +183,23 @@ void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions
   const auto& h = grid.heights_agl;
   for (std::size_t n = 0; n < h.size(); ++n) {
     if (!std::isfinite(h[n]) || h[n] < 0.0 || h[n] > 100000.0) bad("height " + num(h[n]) + ": must be within [0, 100000] m");
+    if (options.model == RfModel::kItm && (h[n] < kItmMinHeight || h[n] > kItmMaxHeight)) {
+      bad("height " + num(h[n]) + ": ITM takes antenna heights within [0.5, 3000] m above ground");
+    }
     if (n > 0 && h[n] <= h[n - 1]) bad("heights must increase");
     if (n > 1 && std::abs((h[n] - h[n - 1]) - (h[1] - h[0])) > 1e-6) bad("heights must be evenly spaced");
   }
-  if (!std::isfinite(options.k_factor) || options.k_factor <= 0.0) bad("k-factor " + num(options.k_factor) + ": must be > 0");
-  if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
 }
 
-std::vector<double> default_heights() {
+void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
+  check_model(tx, options);
+  check_grid(grid, options);
+}
+
+std::vector<double> default_heights(RfModel model) {
+  const double first = model == RfModel::kItm ? 10.0 : 0.0;
   std::vector<double> h;
-  for (int n = 0; n <= 40; ++n) h.push_back(50.0 * n);
+  for (int n = 0; n <= 40; ++n) h.push_back(first + 50.0 * n);
   return h;
 }
 
@@ -204,6 +236,101 @@ double path_loss_db(const PathProfile& p, double frequency_mhz, double k_factor,
   return free_space_loss_db(r, frequency_mhz) + diffraction_loss_db(p, frequency_mhz, k_factor, edge_depth);
 }
 
+void sample_profile(const io::Grid& dem, double tx_lat, double tx_lon, double rx_lat, double rx_lon, double step_m,
+                    TerrainProfile& out) {
+  const DemSampler ground(dem);
+  double distance = 0.0;
+  GeographicLib::Geodesic::WGS84().Inverse(tx_lat, tx_lon, rx_lat, rx_lon, distance);
+  const int segments = std::max(1, static_cast<int>(std::ceil(distance / step_m)));
+  out.distance_m = distance;
+  out.ground_m.resize(static_cast<std::size_t>(segments) + 1);
+  out.ground_m[0] = ground(tx_lat, tx_lon);
+  // Along the line the grid position is affine in the sample index: stepped from the
+  // transmitter's (the same points to rounding, without two divisions per sample).
+  const double c_tx = ground.column(tx_lon), r_tx = ground.row(tx_lat);
+  const double dc = (ground.column(rx_lon) - c_tx) / segments, dr = (ground.row(rx_lat) - r_tx) / segments;
+  for (int m = 1; m < segments; ++m) out.ground_m[static_cast<std::size_t>(m)] = ground.at(c_tx + m * dc, r_tx + m * dr);
+  out.ground_m[static_cast<std::size_t>(segments)] = ground(rx_lat, rx_lon);
+}
+
+struct ColumnModel::State {
+  Transmitter tx;
+  RfOptions options;
+  double lambda = 0.0, two_ka = 0.0;
+  std::vector<double> x, y;      // Deygout's profile: distances, heights raised by the bulge
+  std::optional<ItmPath> itm;
+};
+
+ColumnModel::ColumnModel(const Transmitter& tx, const RfOptions& options) : s_(std::make_unique<State>()) {
+  check_model(tx, options);
+  s_->tx = tx;
+  s_->options = options;
+  s_->options.progress = nullptr;
+  s_->lambda = wavelength(tx.frequency_mhz);
+  s_->two_ka = 2.0 * options.k_factor * kEarthRadius;
+  if (options.model == RfModel::kItm) s_->itm.emplace(tx.frequency_mhz, options.itm);
+}
+
+ColumnModel::~ColumnModel() = default;
+ColumnModel::ColumnModel(ColumnModel&&) noexcept = default;
+ColumnModel& ColumnModel::operator=(ColumnModel&&) noexcept = default;
+
+std::size_t ColumnModel::path_loss(const TerrainProfile& profile, std::span<const double> heights, std::span<float> out) {
+  State& s = *s_;
+  const std::size_t n = profile.ground_m.size();
+  const double distance = profile.distance_m;
+  std::size_t warned = 0;
+  if (s.itm) {
+    if (!(distance > 0.0)) {
+      for (float& v : out) v = std::numeric_limits<float>::quiet_NaN();
+      return 0;
+    }
+    s.itm->set_profile(profile.ground_m, distance / static_cast<double>(n - 1), s.tx.height_agl);
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      const ItmLoss r = s.itm->loss(heights[k]);
+      out[k] = static_cast<float>(r.loss_db);
+      if (r.warning >= 3) ++warned;
+    }
+    return warned;
+  }
+  const int segments = static_cast<int>(n) - 1;
+  s.x.resize(n);
+  s.y.resize(n);
+  s.x[0] = 0.0;
+  s.y[0] = profile.ground_m[0] + s.tx.height_agl;
+  for (int m = 1; m < segments; ++m) {
+    const double t = static_cast<double>(m) / segments;
+    const double d = t * distance;
+    s.x[static_cast<std::size_t>(m)] = d;
+    s.y[static_cast<std::size_t>(m)] = profile.ground_m[static_cast<std::size_t>(m)] + d * (distance - d) / s.two_ka;
+  }
+  s.x[static_cast<std::size_t>(segments)] = distance;
+  for (std::size_t k = 0; k < heights.size(); ++k) {
+    const double rx_top = profile.ground_m[static_cast<std::size_t>(segments)] + heights[k];
+    s.y[static_cast<std::size_t>(segments)] = rx_top;
+    const double dh = rx_top - s.y[0];
+    const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
+    out[k] = static_cast<float>(free_space_loss_db(slant, s.tx.frequency_mhz) +
+                                deygout(s.x.data(), s.y.data(), 0, segments, false, false, s.lambda, s.options.edge_depth));
+  }
+  return 0;
+}
+
+std::string ColumnModel::description() const {
+  const RfOptions& o = s_->options;
+  if (o.model == RfModel::kItm) {
+    const ItmParameters& p = o.itm;
+    return "Longley-Rice ITM 1.2.2 point-to-point (Hufford's Algorithm): " +
+           std::string(p.polarization == ItmPolarization::kVertical ? "vertical" : "horizontal") +
+           " polarization, ground permittivity " + num(p.permittivity) + ", conductivity " + num(p.conductivity) +
+           " S/m, N_0 " + num(p.refractivity) + " N-units, " + itm_climate_name(p.climate) + " climate, time " +
+           num(p.time) + ", location " + num(p.location) + ", situation " + num(p.situation) + ", MDVAR " +
+           std::to_string(p.mdvar());
+  }
+  return "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " + std::to_string(o.edge_depth) +
+         " levels, earth bulge with k = " + num(o.k_factor);
+}
+
 double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km) {
   const double dem_m = dem_spacing_arcsec / 3600.0 * (M_PI / 180.0) * kEarthRadius;
   const double wanted_m = 2.0 * radius_km * 1000.0 / 256.0;
@@ -223,7 +350,7 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
                                 num(south) + ".." + num(north) + " N, " + num(west) + ".." + num(east) + " E)");
   }
   RfGrid grid = grid_in;
-  if (grid.heights_agl.empty()) grid.heights_agl = default_heights();
+  if (grid.heights_agl.empty()) grid.heights_agl = default_heights(options.model);
   if (grid.spacing_arcsec == 0.0) grid.spacing_arcsec = default_spacing_arcsec(g.dy * 3600.0, grid.radius_km);
 
   RfResult result;
@@ -259,65 +386,61 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
   }
   loss.values.assign(l.size(), 0.0f);
   loss.active_points = l.size();
+  const ColumnModel prototype(tx, options);
   loss.attributes = {
       {"tx_lat", num(tx.lat)},
       {"tx_lon", num(tx.lon)},
       {"tx_height_agl_m", num(tx.height_agl)},
       {"frequency_mhz", num(tx.frequency_mhz)},
-      {"k_factor", num(options.k_factor)},
-      {"model", "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " +
-                    std::to_string(options.edge_depth) + " levels, earth bulge with k = " + num(options.k_factor)},
+      {"model", prototype.description()},
       {"vertical_datum", dem.vertical_datum},
   };
+  if (options.model == RfModel::kDeygout) loss.attributes["k_factor"] = num(options.k_factor);
   if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
 
-  const DemSampler ground(dem);
   const double step_m = std::min(g.dx * mlon, g.dy * mlat);
-  const double lambda = wavelength(tx.frequency_mhz);
-  const double two_ka = 2.0 * options.k_factor * kEarthRadius;
-  const double tx_top = ground(tx.lat, tx.lon) + tx.height_agl;
-  const GeographicLib::Geodesic& geod = GeographicLib::Geodesic::WGS84();
   const std::size_t n_columns = static_cast<std::size_t>(l.dims[0]) * static_cast<std::size_t>(l.dims[1]);
   const std::size_t layer = n_columns;
+  std::vector<double> heights_m(static_cast<std::size_t>(nh));
+  for (int k = 0; k < nh; ++k) heights_m[static_cast<std::size_t>(k)] = l.world(2, k);
 
-  std::atomic<std::size_t> done{0}, samples{0};
+  // The disc: decided from the flat distance in the transmitter's frame where that is clearly
+  // inside or outside (it is within 0.5% of the geodesic one over 500 km), by the geodesic
+  // near the rim.
+  auto outside_disc = [&](double lat, double lon) {
+    if (!grid.disc) return false;
+    const double flat = std::hypot((lon - tx.lon) * mlon, (lat - tx.lat) * mlat);
+    if (flat < 0.99 * radius_m) return false;
+    if (flat > 1.01 * radius_m) return true;
+    double distance = 0.0;
+    GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, lat, lon, distance);
+    return distance > radius_m;
+  };
+  std::atomic<std::size_t> done{0}, samples{0}, warned{0}, computed{0};
   std::mutex progress_mutex;
   int reported = -1;
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_columns, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    std::vector<double> x, y;
-    std::size_t local_samples = 0;
+    ColumnModel model(tx, options);
+    TerrainProfile profile;
+    std::vector<float> column(static_cast<std::size_t>(nh));
+    std::size_t local_samples = 0, local_warned = 0, local_computed = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const int i = static_cast<int>(c % static_cast<std::size_t>(l.dims[0]));
       const int j = static_cast<int>(c / static_cast<std::size_t>(l.dims[0]));
-      const double rx_lon = l.world(0, i), rx_lat = l.world(1, j);
-      double distance = 0.0;
-      geod.Inverse(tx.lat, tx.lon, rx_lat, rx_lon, distance);
-      const int segments = std::max(1, static_cast<int>(std::ceil(distance / step_m)));
-      x.resize(static_cast<std::size_t>(segments) + 1);
-      y.resize(static_cast<std::size_t>(segments) + 1);
-      x[0] = 0.0;
-      y[0] = tx_top;
-      for (int m = 1; m < segments; ++m) {
-        const double t = static_cast<double>(m) / segments;
-        const double d = t * distance;
-        x[m] = d;
-        y[m] = ground(tx.lat + t * (rx_lat - tx.lat), tx.lon + t * (rx_lon - tx.lon)) + d * (distance - d) / two_ka;
+      if (outside_disc(l.world(1, j), l.world(0, i))) {
+        for (int k = 0; k < nh; ++k) loss.values[c + layer * static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
+        continue;
       }
-      x[segments] = distance;
-      local_samples += static_cast<std::size_t>(segments - 1);
-      const double rx_ground = ground(rx_lat, rx_lon);
-      for (int k = 0; k < nh; ++k) {
-        const double rx_top = rx_ground + l.world(2, k);
-        y[segments] = rx_top;
-        const double dh = rx_top - tx_top;
-        const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
-        const double value = free_space_loss_db(slant, tx.frequency_mhz) +
-                             deygout(x.data(), y.data(), 0, segments, false, false, lambda, options.edge_depth);
-        loss.values[c + layer * static_cast<std::size_t>(k)] = static_cast<float>(value);
-      }
+      ++local_computed;
+      sample_profile(dem, tx.lat, tx.lon, l.world(1, j), l.world(0, i), step_m, profile);
+      local_samples += profile.ground_m.size() - 2;
+      local_warned += model.path_loss(profile, heights_m, column);
+      for (int k = 0; k < nh; ++k) loss.values[c + layer * static_cast<std::size_t>(k)] = column[static_cast<std::size_t>(k)];
     }
     samples += local_samples;
+    warned += local_warned;
+    computed += local_computed;
     const std::size_t now = done += r.size();
     if (options.progress) {
       const int percent = static_cast<int>(100.0 * static_cast<double>(now) / static_cast<double>(n_columns));
@@ -329,8 +452,21 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     }
   });
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  result.columns = n_columns;
-  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(n_columns);
+  result.columns = computed.load();
+  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(std::max<std::size_t>(1, computed.load()));
+  if (grid.disc) {
+    result.notes.push_back("the " + std::to_string(n_columns - computed.load()) + " columns farther than " +
+                           num(grid.radius_km) + " km from the transmitter are NaN (disc)");
+    loss.attributes["disc_radius_km"] = num(grid.radius_km);
+  }
+  if (options.model == RfModel::kItm) {
+    result.notes.push_back("ITM has no value at the transmitter's own column (NaN)");
+    if (warned > 0) {
+      result.notes.push_back(std::to_string(warned.load()) + " of " + std::to_string(l.size()) +
+                             " points carry ITM warning 3 or 4: parameters outside the model's range (paths under 1 km, "
+                             "N_s under 250 N-units over high ground, steep horizons); computed anyway");
+    }
+  }
 
   if (tx.erp_w) {
     Volume signal = loss;

@@ -771,8 +771,9 @@ SplatRunResult run_splat(const SplatRunOptions& o) {
     const std::string h = num(o.heights_agl[n]);
     const std::string ano = "rx-" + std::to_string(n) + ".ano",
                       log_name = "splat-" + std::to_string(n) + ".log";
-    const std::vector<std::string> args = {
+    std::vector<std::string> args = {
         exe, "-t", "tx.qth", "-L", h, "-R", num(o.radius_km), "-metric", "-erp", "0", "-ano", ano};
+    if (o.olditm) args.push_back("-olditm");
     const std::string what = "splat -L " + h;
     const ChildOutcome c = run_child(args, work.path(), work.path() / log_name, o.timeout_seconds);
     if (!c.started) throw std::runtime_error(exe + ": cannot run (" + c.start_error + ")");

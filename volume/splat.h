@@ -133,6 +133,8 @@ struct SplatRunOptions {
   std::vector<double> heights_agl;   // receiver heights, metres above ground (-L), >= 0
   double radius_km = 20.0;           // SPLAT!'s -R: the radius of the computed disc, (0, 1000]
   double timeout_seconds = 600.0;    // per height; the child is killed after it
+  bool olditm = false;               // -olditm: SPLAT!'s Longley-Rice ITM (1.2.2) instead of
+                                     // its default ITWOM 3.0
   std::filesystem::path work_root;   // where the temporary working folder goes; empty: the
                                      // system's temporary folder
   bool keep_ano_texts = false;       // fill SplatRunResult::ano_texts
@@ -155,7 +157,7 @@ struct SplatRunResult {
 // colon names ("40:41:111:112.sdf": SPLAT! 1.4.2 silently assumes sea level for any tile it
 // cannot find under that name); tx.qth and tx.lrp are written (the site's name reduced to
 // letters, digits, '-', '_' and '.', since SPLAT! names its report after it); then, for each height
-// H, `splat -t tx.qth -L H -R radius -metric -erp 0 -ano OUT` runs as a child (stdin /dev/null, its
+// H, `splat -t tx.qth -L H -R radius -metric -erp 0 -ano OUT [-olditm]` runs as a child (stdin /dev/null, its
 // output kept for messages) and OUT is parsed with parse_ano. Throws std::runtime_error, one line
 // each: the executable is missing; the folder holds no tile for part of the disc (SPLAT! would take
 // it as sea level); a tile cannot be read or decompressed (io::FormatError); SPLAT! cannot be

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <vector>
 
 #include "io/error.h"
 #include "io/srtm_write.h"
@@ -66,6 +68,58 @@ TEST(Mosaic, WindowInsideOneTileLoadsOnlyThatTile) {
   EXPECT_EQ(m.loads(), 2u);
   m.read_window(20, 30, 64, 64);
   EXPECT_EQ(m.loads(), 3u) << "a one-tile cache evicted the first tile";
+}
+
+// The window is read as a whole (its tiles decoded together) or tile by tile: tile_grid()
+// of a mosaic with a one-tile cache copied by hand is the reference.
+TEST(Mosaic, WindowOverFourTilesDecodedTogetherHoldsEachTilesOwnSamples) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w, 7.0f);  // edges differ: order shows
+  const Mosaic together = Mosaic::open({dir.path()});
+  const Mosaic one_by_one = Mosaic::open({dir.path()}, {}, 1);
+  const int row0 = 1000, col0 = 1100, rows = 401, cols = 201;
+  const Grid w = together.read_window(row0, col0, rows, cols);
+  EXPECT_EQ(together.loads(), 4u);
+  std::vector<char> done(static_cast<std::size_t>(rows) * cols, 0);
+  for (std::size_t i = 0; i < one_by_one.tiles().size(); ++i) {
+    const MosaicTile& t = one_by_one.tiles()[i];
+    const Grid& g = one_by_one.tile_grid(i);
+    for (int r = std::max(row0, t.row0); r < std::min(row0 + rows, t.row0 + t.rows); ++r)
+      for (int c = std::max(col0, t.col0); c < std::min(col0 + cols, t.col0 + t.cols); ++c) {
+        const std::size_t o = static_cast<std::size_t>(r - row0) * cols + (c - col0);
+        if (done[o]) continue;  // the first tile in input order gives a shared sample
+        done[o] = 1;
+        ASSERT_EQ(w.heights[o], g.heights[g.index(r - t.row0, c - t.col0)]) << "row " << r << " column " << c;
+      }
+  }
+  EXPECT_EQ(std::count(done.begin(), done.end(), 1), static_cast<long>(rows) * cols);
+  together.read_window(row0, col0, rows, cols);
+  EXPECT_EQ(together.loads(), 4u) << "the second read comes from the cache";
+}
+
+TEST(Mosaic, WindowNeedingMoreTilesThanTheCacheReadsEachOnce) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w);
+  const Mosaic m = Mosaic::open({dir.path()}, {}, 3);
+  m.read_window(1100, 1150, 200, 100);
+  EXPECT_EQ(m.loads(), 4u);
+}
+
+TEST(Mosaic, TwoBrokenTilesInOneWindowReportTheFirstInTileOrder) {
+  test::TempDir dir;
+  for (const char* name : {"40_41_111_112.sdf", "40_41_112_113.sdf"}) std::ofstream(dir.path() / name) << "not an SDF file\n";
+  const Mosaic m = Mosaic::open({dir.path()});
+  ASSERT_EQ(m.tiles().size(), 2u);
+  for (int n = 0; n < 5; ++n) {  // the two fail in either order when decoded together
+    try {
+      m.read_window(0, 1190, 10, 20);
+      FAIL() << "expected FormatError";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find(m.tiles()[0].path.filename().string()), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Mosaic, SharedEdgeSamplesComeFromTheFirstTileOnly) {
