@@ -13,7 +13,7 @@ namespace {
 using test::run_terravol;
 
 nlohmann::json info_json(const std::string& path) {
-  const auto r = run_terravol("info --json " + path);
+  const auto r = run_terravol("info --json " + path, 120);  // the Utah tiles take 5-30 s under load
   EXPECT_EQ(r.status, 0) << r.err;
   return nlohmann::json::parse(r.out);
 }
@@ -151,11 +151,12 @@ TEST(InfoCli, UtahSdfDirectoryIsOneMosaic) {
   EXPECT_EQ(j["gap_samples"], 0);
 }
 
-// Bad input: one line "terravol: FILE: what is wrong", exit status 1 or 2, within a second.
+// Bad input: one line "terravol: FILE: what is wrong", exit status 1 or 2, and no hang (the
+// 10 s bound is a hang guard; it takes about 0.1 s, more under load).
 void expect_clean_failure(const std::string& args, const std::string& must_mention) {
   const auto r = run_terravol(args);
   EXPECT_TRUE(r.status == 1 || r.status == 2) << args << " exited " << r.status << "\n" << r.err;
-  EXPECT_LT(r.seconds, 1.0) << args;
+  EXPECT_LT(r.seconds, 10.0) << args;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find(must_mention), std::string::npos) << r.err;
 }

@@ -45,7 +45,7 @@ double median_finite(const Volume& v, int k) {
   return x[x.size() / 2];
 }
 
-// One SPLAT! run over Salt Lake City at three heights (about 5 s), then its -ano files
+// One SPLAT! run over Salt Lake City at three heights (about 5 s on an idle machine), then its -ano files
 // imported again, then compared with itself and with the built-in model.
 TEST(SplatCli, RunsSplatOnTheUtahTilesImportsItsOutputAndCompares) {
   const auto tiles = test::shared_dem("utah_sdf");
@@ -56,9 +56,9 @@ TEST(SplatCli, RunsSplatOnTheUtahTilesImportsItsOutputAndCompares) {
   const auto out = dir.path() / "splat.vdb";
   const auto r = run_terravol("splat-volume --tx 40.76,-111.89,30,900,50 --sdf " + tiles.string() +
                               " --heights 10:110:50 --radius-km 8 --ano-dir " +
-                              dir.path().string() + " -o " + out.string());
+                              dir.path().string() + " -o " + out.string(),
+                              300);  // a guard against a hang only: SPLAT! takes 5-40 s with the machine's load
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_LT(r.seconds, 25.0);
   EXPECT_NE(r.out.find("wrote " + out.string() + ": path_loss_db and signal_dbm"),
             std::string::npos)
       << r.out;
