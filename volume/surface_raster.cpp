@@ -57,8 +57,8 @@ io::GeoRaster footprint_raster(const Volume& volume) {
       enu.Reverse(0.0, l.spacing[1], 0.0, lat_n, lon, h);
       enu.Reverse(l.spacing[0], 0.0, 0.0, lat, lon_e, h);
       const double dlat = lat_n - f.origin_lat, dlon = lon_e - f.origin_lon;
-      const int rows = static_cast<int>(std::min(std::floor((north - south) / dlat + 1e-9) + 1.0, 1e9));
-      const int cols = static_cast<int>(std::min(std::floor((east - west) / dlon + 1e-9) + 1.0, 1e9));
+      const int rows = static_cast<int>(std::min(std::ceil((north - south) / dlat - 1e-6) + 1.0, 1e9));
+      const int cols = static_cast<int>(std::min(std::ceil((east - west) / dlon - 1e-6) + 1.0, 1e9));
       return sized(rows, cols, west - 0.5 * dlon, north + 0.5 * dlat, dlon, dlat);
     }
   }

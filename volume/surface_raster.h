@@ -23,7 +23,8 @@ struct SurfaceHeight {
 //   lattice spacings;
 // - an ENU frame: the geographic bounding box of the lattice's eight corners, pixel centres
 //   from its north-west corner at the lattice's east and north spacings in degrees at the
-//   origin (GeographicLib LocalCartesian), as many as reach the box's south and east edges.
+//   origin (GeographicLib LocalCartesian, at the origin's height), as many as it takes to
+//   reach the box's south and east edges.
 // Throws std::invalid_argument for a volume without a frame, or a raster of more than
 // kMaxPoints pixels.
 io::GeoRaster footprint_raster(const Volume& volume);
