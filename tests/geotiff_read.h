@@ -25,13 +25,30 @@ struct GeoTiffContents {
   std::vector<float> values;  // row-major, row 0 first
 };
 
+// GDAL's two tags, registered before a directory is read (a tag merged later stays anonymous).
+inline TIFFExtendProc& parent_tag_extender() {
+  static TIFFExtendProc parent = nullptr;
+  return parent;
+}
+inline void gdal_tag_extender(TIFF* tif) {
+  static const TIFFFieldInfo kFields[] = {
+      {TIFFTAG_GDAL_NODATA, TIFF_VARIABLE, TIFF_VARIABLE, TIFF_ASCII, FIELD_CUSTOM, 1, 0,
+       const_cast<char*>("GDALNoDataValue")},
+      {42112, TIFF_VARIABLE, TIFF_VARIABLE, TIFF_ASCII, FIELD_CUSTOM, 1, 0, const_cast<char*>("GDALMetadata")}};
+  TIFFMergeFieldInfo(tif, kFields, 2);
+  if (parent_tag_extender()) parent_tag_extender()(tif);
+}
+
 inline GeoTiffContents read_geotiff_file(const std::filesystem::path& path) {
+  static const bool registered = [] {
+    XTIFFInitialize();
+    parent_tag_extender() = TIFFSetTagExtender(gdal_tag_extender);
+    return true;
+  }();
+  (void)registered;
   GeoTiffContents c;
-  static const TIFFFieldInfo kNoData[] = {{TIFFTAG_GDAL_NODATA, TIFF_VARIABLE, TIFF_VARIABLE, TIFF_ASCII,
-                                           FIELD_CUSTOM, 1, 0, const_cast<char*>("GDALNoDataValue")}};
   TIFF* tif = XTIFFOpen(path.c_str(), "r");
   if (tif == nullptr) return c;
-  TIFFMergeFieldInfo(tif, kNoData, 1);
   c.opened = true;
   TIFFGetField(tif, TIFFTAG_IMAGEWIDTH, &c.width);
   TIFFGetField(tif, TIFFTAG_IMAGELENGTH, &c.height);
