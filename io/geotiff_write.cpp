@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "io/bytes.h"
 #include "io/tiff_memory.h"
 
 namespace terravol::io {
@@ -14,20 +15,17 @@ namespace {
 
 constexpr std::uint32_t kRowsPerStrip = 16;
 
-// GDAL's metadata XML with the band's unit, as GDAL writes it (GDALPamDataset, "unit" role).
-std::string gdal_metadata(const std::string& units) {
-  std::string escaped;
-  for (const char c : units) {
-    switch (c) {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
-    }
+// GDAL's metadata XML with the band's description and unit, as GDAL's GTiff driver writes
+// and reads them back (items with role "description" and "unittype").
+std::string gdal_metadata(const GeoTiffText& text) {
+  std::string xml = "<GDALMetadata>\n";
+  if (!text.description.empty()) {
+    xml += "  <Item name=\"DESCRIPTION\" sample=\"0\" role=\"description\">" + xml_escaped(text.description) + "</Item>\n";
   }
-  return "<GDALMetadata>\n  <Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype\">" + escaped +
-         "</Item>\n</GDALMetadata>\n";
+  if (!text.units.empty()) {
+    xml += "  <Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype\">" + xml_escaped(text.units) + "</Item>\n";
+  }
+  return xml + "</GDALMetadata>\n";
 }
 
 }  // namespace
@@ -65,7 +63,9 @@ std::vector<std::uint8_t> encode_geotiff(const GeoRaster& raster, const GeoTiffT
     TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, kRowsPerStrip);
     TIFFSetField(t, TIFFTAG_SOFTWARE, "terravol");
     if (!text.description.empty()) TIFFSetField(t, TIFFTAG_IMAGEDESCRIPTION, text.description.c_str());
-    if (!text.units.empty()) TIFFSetField(t, tiff::kGdalMetadata, gdal_metadata(text.units).c_str());
+    if (!text.description.empty() || !text.units.empty()) {
+      TIFFSetField(t, tiff::kGdalMetadata, gdal_metadata(text).c_str());
+    }
     TIFFSetField(t, TIFFTAG_GDAL_NODATA, "nan");
     const double tiepoint[6] = {0.0, 0.0, 0.0, raster.west, raster.north, 0.0};
     const double scale[3] = {raster.dlon, raster.dlat, 0.0};

@@ -10,9 +10,11 @@
 
 namespace terravol::io {
 
+// Text GIS tools show: the description goes to ImageDescription and, with the units, to
+// GDAL_METADATA as the band's description and unit type.
 struct GeoTiffText {
-  std::string description;  // ImageDescription, e.g. "path_loss_db at 10 m above ground"
-  std::string units;        // GDAL_METADATA's unit item (GDAL: band unit type), e.g. "dB"
+  std::string description;  // e.g. "path_loss_db (dB) at 10 m above ground"
+  std::string units;        // e.g. "dB"
 };
 
 // The GeoTIFF bytes of `raster`: float32, one sample per pixel, in strips of 16 rows,

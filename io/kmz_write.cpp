@@ -7,24 +7,11 @@
 #include <memory>
 #include <stdexcept>
 
+#include "io/bytes.h"
+
 namespace terravol::io {
 
 namespace {
-
-std::string xml_escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string degrees(double v) {
   char b[40];

@@ -22,6 +22,7 @@ struct GeoTiffContents {
   int model_type = 0, raster_type = 0, geographic_type = 0, angular_units = 0;
   std::string nodata;       // GDAL_NODATA, "" when absent
   std::string description;  // ImageDescription
+  std::string gdal_metadata;  // GDAL_METADATA (XML), "" when absent
   std::vector<float> values;  // row-major, row 0 first
 };
 
@@ -62,6 +63,7 @@ inline GeoTiffContents read_geotiff_file(const std::filesystem::path& path) {
   char* text = nullptr;
   if (TIFFGetField(tif, TIFFTAG_GDAL_NODATA, &text) && text) c.nodata = text;
   if (TIFFGetField(tif, TIFFTAG_IMAGEDESCRIPTION, &text) && text) c.description = text;
+  if (TIFFGetField(tif, 42112, &text) && text) c.gdal_metadata = text;
   if (GTIF* gt = GTIFNew(tif)) {
     unsigned short s = 0;
     if (GTIFKeyGet(gt, GTModelTypeGeoKey, &s, 0, 1) == 1) c.model_type = s;

@@ -7,6 +7,7 @@
 
 #include "compress.h"
 #include "io/error.h"
+#include "parse_check.h"
 #include "temp_dir.h"
 
 namespace terravol::io {
@@ -40,17 +41,6 @@ ByteVector decompress(const std::string& extension, const ByteVector& data, std:
   if (extension == ".bz2") return bunzip2(data, "src", limit);
   if (extension == ".xz") return unxz(data, "src", limit);
   return unzip_entry(data, "src", kHgt, limit).bytes;
-}
-
-// The one-line message of the FormatError `f` throws ("" when it throws none).
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 void expect_one_line_error(const std::string& what, const std::string& context) {
@@ -88,16 +78,16 @@ TEST(CompressionMagic, EachFormatIsKnownByItsFirstBytes) {
 
 TEST(CompressionMagic, ANameThatDisagreesWithTheBytesIsAOneLineError) {
   const ByteVector bz = test::bzip2_bytes(random_bytes(1000, 2));
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kGzip, bz, "src"); }), "src: named .gz but holds bzip2 data");
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kGzip, bz, "src"); }), "src: named .gz but holds bzip2 data");
   const std::string text = "ncols 3\n";
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kXz, ByteVector(text.begin(), text.end()), "src"); }),
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kXz, ByteVector(text.begin(), text.end()), "src"); }),
             "src: named .xz but is not xz data");
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kGzip, ByteVector{0x1f}, "src"); }),
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kGzip, ByteVector{0x1f}, "src"); }),
             "src: gzip data is truncated (1 bytes)");
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kZip, ByteVector{}, "src"); }),
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kZip, ByteVector{}, "src"); }),
             "src: zip data is truncated (0 bytes)");
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kBzip2, bz, "src"); }), "");
-  EXPECT_EQ(error_of([&] { check_magic(Compression::kNone, bz, "src"); }), "") << "no name, no check";
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kBzip2, bz, "src"); }), "");
+  EXPECT_EQ(test::format_error_of([&] { check_magic(Compression::kNone, bz, "src"); }), "") << "no name, no check";
 }
 
 TEST(Decompress, EveryFormatRoundTripsEmptySmallAndMultiChunkData) {
@@ -122,11 +112,11 @@ TEST(Decompress, ZeroPaddingAfterTheDataIsIgnoredAndOtherTrailingBytesAreAnError
   EXPECT_EQ(gunzip(concat(test::gzip_bytes(a), zeros), "src"), a);
   EXPECT_EQ(bunzip2(concat(test::bzip2_bytes(a), zeros), "src"), a);
   EXPECT_EQ(unxz(concat(test::xz_bytes(a), zeros), "src"), a);
-  EXPECT_EQ(error_of([&] { gunzip(concat(test::gzip_bytes(a), junk), "src"); }),
+  EXPECT_EQ(test::format_error_of([&] { gunzip(concat(test::gzip_bytes(a), junk), "src"); }),
             "src: 4 bytes after the end of the gzip data are not another gzip stream");
-  EXPECT_EQ(error_of([&] { bunzip2(concat(test::bzip2_bytes(a), junk), "src"); }),
+  EXPECT_EQ(test::format_error_of([&] { bunzip2(concat(test::bzip2_bytes(a), junk), "src"); }),
             "src: 4 bytes after the end of the bzip2 data are not another bzip2 stream");
-  expect_one_line_error(error_of([&] { unxz(concat(test::xz_bytes(a), junk), "src"); }), "xz junk");
+  expect_one_line_error(test::format_error_of([&] { unxz(concat(test::xz_bytes(a), junk), "src"); }), "xz junk");
 }
 
 TEST(Decompress, OutputOfExactlyTheLimitPassesAndOneByteMoreIsRefused) {
@@ -134,7 +124,7 @@ TEST(Decompress, OutputOfExactlyTheLimitPassesAndOneByteMoreIsRefused) {
   for (const std::string& ext : kExtensions) {
     const ByteVector packed = test::compress_as(ext, a, "x.hgt");
     EXPECT_EQ(decompress(ext, packed, a.size()), a) << ext;
-    EXPECT_EQ(error_of([&] { decompress(ext, packed, a.size() - 1); }), "src: decompresses to more than 2999 bytes")
+    EXPECT_EQ(test::format_error_of([&] { decompress(ext, packed, a.size() - 1); }), "src: decompresses to more than 2999 bytes")
         << ext;
   }
 }
@@ -145,7 +135,7 @@ TEST(Decompress, EveryTruncationIsAOneLineError) {
     const ByteVector packed = test::compress_as(ext, a, "x.hgt");
     for (std::size_t n = 0; n < packed.size(); n += (n < 64 ? 1 : 7)) {
       const ByteVector cut(packed.begin(), packed.begin() + static_cast<std::ptrdiff_t>(n));
-      const std::string what = error_of([&] { decompress(ext, cut); });
+      const std::string what = test::format_error_of([&] { decompress(ext, cut); });
       ASSERT_FALSE(what.empty()) << ext << " cut at " << n << " decompressed without an error";
       expect_one_line_error(what, ext + " cut at " + std::to_string(n));
     }
@@ -162,7 +152,7 @@ TEST(Decompress, AFlippedByteIsCaughtByTheFormatsCheck) {
       // Past the headers: zip's local header is 30 bytes plus the name.
       std::uniform_int_distribution<std::size_t> at(ext == ".zip" ? 40 : 12, packed.size() / 2);
       bad[at(rng)] ^= 0x55;
-      const std::string what = error_of([&] { decompress(ext, bad); });
+      const std::string what = test::format_error_of([&] { decompress(ext, bad); });
       ASSERT_FALSE(what.empty()) << ext << ": a corrupt stream decompressed without an error";
       expect_one_line_error(what, ext);
     }
@@ -192,7 +182,7 @@ ByteVector with_huge_dictionary(ByteVector xz) {
 
 TEST(Decompress, XzAskingForAHugeDictionaryIsRefusedBeforeAllocating) {
   const ByteVector packed = with_huge_dictionary(test::xz_bytes(random_bytes(1000, 10)));
-  EXPECT_EQ(error_of([&] { unxz(packed, "src"); }), "src: xz data needs more than 256 MiB of memory to decompress");
+  EXPECT_EQ(test::format_error_of([&] { unxz(packed, "src"); }), "src: xz data needs more than 256 MiB of memory to decompress");
 }
 
 TEST(Unzip, TheFirstEntryWithAWantedSuffixIsReadAndMacCopiesAreSkipped) {
@@ -206,7 +196,7 @@ TEST(Unzip, TheFirstEntryWithAWantedSuffixIsReadAndMacCopiesAreSkipped) {
   EXPECT_EQ(e.name, "tiles/N44W072.HGT");
   EXPECT_EQ(e.bytes, b);
   constexpr std::string_view kDted[] = {".dt0", ".dt1", ".dt2"};
-  EXPECT_EQ(error_of([&] { unzip_entry(archive, "src", kDted); }),
+  EXPECT_EQ(test::format_error_of([&] { unzip_entry(archive, "src", kDted); }),
             "src: zip archive holds no *.dt0 or *.dt1 or *.dt2 file");
   EXPECT_EQ(unzip_named(archive, "src", "README.TXT"), a);
   EXPECT_FALSE(unzip_named(archive, "src", "tiles/readme.txt"));
@@ -214,7 +204,7 @@ TEST(Unzip, TheFirstEntryWithAWantedSuffixIsReadAndMacCopiesAreSkipped) {
 
 TEST(Unzip, AnEntryOverTheLimitIsRefusedFromItsRecordedSize) {
   const ByteVector archive = test::zip_bytes({{"x.hgt", ByteVector(5000, 1)}});
-  EXPECT_EQ(error_of([&] { unzip_entry(archive, "src", kHgt, 4999); }), "src: decompresses to more than 4999 bytes");
+  EXPECT_EQ(test::format_error_of([&] { unzip_entry(archive, "src", kHgt, 4999); }), "src: decompresses to more than 4999 bytes");
 }
 
 TEST(RecordedSize, GzipXzAndZipSayTheirSizeAndBzip2DoesNot) {

@@ -7,6 +7,7 @@
 #include "compress.h"
 #include "io/compressed.h"
 #include "io/error.h"
+#include "parse_check.h"
 #include "shared_data.h"
 #include "temp_dir.h"
 
@@ -42,17 +43,6 @@ const std::string kUtmGrid =
     "ncols 3\nnrows 2\nxllcorner 500000\nyllcorner 4000000\ncellsize 30\nNODATA_value -9999\n"
     "1 2 3\n4 -9999 6\n";
 const std::string kUtmPrj = "PROJCS[\"WGS_1984_UTM_Zone_10N\",GEOGCS[\"GCS_WGS_1984\"]]";
-
-// The message of the FormatError f throws, "" when none.
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const FormatError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(FormatFromName, EveryFormatIsKnownPlainAndUnderEveryCompression) {
   const std::pair<const char*, Format> names[] = {
@@ -95,14 +85,14 @@ TEST(ReadDem, ZippedEsriGridTakesItsProjectionFromTheArchive) {
   EXPECT_EQ(g.georef.utm_zone, 10);
   // Without the .prj, in the archive or beside it, the metres cannot be placed.
   test::write_file_bytes(path, test::zip_bytes({{"data/grid.asc", text_bytes(kUtmGrid)}}));
-  EXPECT_NE(error_of([&] { read_dem(path); }).find("coordinates are not degrees"), std::string::npos);
+  EXPECT_NE(test::format_error_of([&] { read_dem(path); }).find("coordinates are not degrees"), std::string::npos);
 }
 
 TEST(ReadDem, ZipArchiveIsSearchedForTheFormatItsNameGives) {
   test::TempDir dir;
   const auto path = dir.path() / "grid.asc.zip";
   test::write_file_bytes(path, test::zip_bytes({{"readme.txt", text_bytes("hello")}}));
-  EXPECT_EQ(error_of([&] { read_dem(path); }), path.string() + ": zip archive holds no *.asc file");
+  EXPECT_EQ(test::format_error_of([&] { read_dem(path); }), path.string() + ": zip archive holds no *.asc file");
 }
 
 TEST(ReadDem, ANameThatDisagreesWithTheContentIsAOneLineError) {
@@ -110,14 +100,14 @@ TEST(ReadDem, ANameThatDisagreesWithTheContentIsAOneLineError) {
   const ByteVector text = text_bytes(kUtmGrid);
   const auto gz = dir.path() / "grid.asc.gz";
   test::write_file_bytes(gz, test::bzip2_bytes(text));
-  EXPECT_EQ(error_of([&] { read_dem(gz); }), gz.string() + ": named .gz but holds bzip2 data");
+  EXPECT_EQ(test::format_error_of([&] { read_dem(gz); }), gz.string() + ": named .gz but holds bzip2 data");
   const auto xz = dir.path() / "grid.asc.xz";
   test::write_file_bytes(xz, text);
-  EXPECT_EQ(error_of([&] { read_dem(xz); }), xz.string() + ": named .xz but is not xz data");
+  EXPECT_EQ(test::format_error_of([&] { read_dem(xz); }), xz.string() + ": named .xz but is not xz data");
   // Compressed content under a plain name: the parser's complaint, and what the file holds.
   const auto plain = dir.path() / "40_41_111_112.sdf";
   test::write_file_bytes(plain, test::gzip_bytes(text));
-  const std::string what = error_of([&] { read_dem(plain); });
+  const std::string what = test::format_error_of([&] { read_dem(plain); });
   EXPECT_EQ(what.rfind(plain.string() + ": ", 0), 0u) << what;
   EXPECT_NE(what.find("(the file holds gzip data: name it 40_41_111_112.sdf.gz)"), std::string::npos) << what;
   EXPECT_EQ(what.find('\n'), std::string::npos) << what;
@@ -131,7 +121,7 @@ TEST(ReadDem, CorruptArchivesAreOneLineErrorsNamingTheFile) {
     const auto path = dir.path() / ("grid.asc" + ext);
     for (const std::size_t cut : {std::size_t{0}, std::size_t{3}, packed.size() / 2, packed.size() - 1}) {
       test::write_file_bytes(path, ByteVector(packed.begin(), packed.begin() + static_cast<std::ptrdiff_t>(cut)));
-      const std::string what = error_of([&] { read_dem(path); });
+      const std::string what = test::format_error_of([&] { read_dem(path); });
       EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << ext << " cut at " << cut << ": " << what;
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }

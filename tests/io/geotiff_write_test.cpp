@@ -54,6 +54,10 @@ TEST(GeoTiffWrite, LibgeotiffReadsTheGeoreferenceAndEveryValueBack) {
   EXPECT_EQ(c.angular_units, Angular_Degree);
   EXPECT_EQ(c.nodata, "nan");
   EXPECT_EQ(c.description, "path_loss_db at 10 m above ground");
+  EXPECT_NE(c.gdal_metadata.find("<Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype\">dB</Item>"), std::string::npos)
+      << c.gdal_metadata;
+  EXPECT_NE(c.gdal_metadata.find("role=\"description\">path_loss_db at 10 m above ground</Item>"), std::string::npos)
+      << c.gdal_metadata;
   ASSERT_EQ(c.values.size(), r.values.size());
   for (std::size_t i = 0; i < r.values.size(); ++i) {
     if (std::isnan(r.values[i])) {
