@@ -120,7 +120,11 @@ std::vector<std::uint8_t> read_zip_entry(zip_t* archive, zip_uint64_t index, con
   if (zip_stat_index(archive, index, 0, &st) != 0) {
     throw FormatError(source, std::string("cannot read zip entry (") + zip_strerror(archive) + ")");
   }
-  const std::string name = st.name != nullptr ? st.name : "?";
+  // The name as stored, for messages: a hostile archive's control characters become '?'.
+  std::string name = st.name != nullptr ? st.name : "?";
+  for (char& c : name) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
   if (!(st.valid & ZIP_STAT_SIZE)) throw FormatError(source, "zip entry " + name + " has no size");
   if (st.size > limit) throw FormatError(source, "decompresses to more than " + size_text(limit));
   zip_file_t* f = zip_fopen_index(archive, index, 0);

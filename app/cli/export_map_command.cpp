@@ -88,7 +88,13 @@ void run_export_map(const ExportMapOptions& o) {
   if (!kmz && (!o.colormap.empty() || !o.range.empty())) {
     throw std::runtime_error("--colormap and --range colour a .kmz; a GeoTIFF holds the values themselves");
   }
-  const volume::Colormap colormap = volume::colormap_by_name(o.colormap.empty() ? "viridis" : o.colormap);
+  const volume::Colormap colormap = [&] {
+    try {
+      return volume::colormap_by_name(o.colormap.empty() ? "viridis" : o.colormap);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error("--colormap " + o.colormap + ": " + e.what());
+    }
+  }();
   const auto range = o.range.empty() ? std::pair<std::optional<double>, std::optional<double>>{} : parse_range(o.range);
   if (!o.force && std::filesystem::exists(o.output)) throw std::runtime_error(out + ": exists (use --force to overwrite)");
   const auto folder = o.output.parent_path();

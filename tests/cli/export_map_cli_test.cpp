@@ -248,7 +248,7 @@ TEST_F(ExportMapCli, BadInputFailsWithOneLineAndWritesNothing) {
       {"--volume " + vdb + " --agl 10 --alt 10 -o " + out, "give the surface: one of --agl H"},
       {"--volume " + vdb + " --agl 10 --colormap jet -o " + out, "--colormap and --range colour a .kmz"},
       {"--volume " + vdb + " --agl 10 --range 1:x -o " + path("x.kmz"), "--range 1:x: 'x' is not a number"},
-      {"--volume " + vdb + " --agl 10 --colormap nope -o " + path("x.kmz"), "unknown colour map 'nope'"},
+      {"--volume " + vdb + " --agl 10 --colormap nope -o " + path("x.kmz"), "--colormap nope: unknown colour map 'nope'"},
       {"--volume " + vdb + " --agl 900 -o " + out,
        "--agl 900: the surface lies outside the volume 'path_loss_db' (heights above ground 0 .. 250 m)"},
       {"--volume " + vdb + " --alt 2000 -o " + out, "--alt 2000: the volume's heights above ground 0 .. 250 m"},

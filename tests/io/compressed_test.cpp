@@ -207,6 +207,15 @@ TEST(Unzip, AnEntryOverTheLimitIsRefusedFromItsRecordedSize) {
   EXPECT_EQ(test::format_error_of([&] { unzip_entry(archive, "src", kHgt, 4999); }), "src: decompresses to more than 4999 bytes");
 }
 
+TEST(Unzip, ACorruptEntryIsNamedOnOneLineEvenWithControlCharactersInItsName) {
+  const ByteVector content = random_bytes(20000, 15);
+  ByteVector archive = test::zip_bytes({{"a\nb.hgt", content}});
+  archive[60] ^= 0xff;  // inside the deflated data, after the 30-byte local header and the name
+  const std::string what = test::format_error_of([&] { unzip_entry(archive, "src", kHgt); });
+  EXPECT_EQ(what.rfind("src: zip entry a?b.hgt is corrupt or truncated", 0), 0u) << what;
+  EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+}
+
 TEST(RecordedSize, GzipXzAndZipSayTheirSizeAndBzip2DoesNot) {
   test::TempDir dir;
   const ByteVector a = random_bytes(123457, 14);
