@@ -10,21 +10,6 @@
 namespace terravol::app::output {
 namespace {
 
-TEST(LegendTicks, RoundStepsOfOneTwoOrFiveGiveThreeToSixLabels) {
-  EXPECT_EQ(legend_ticks(60.37, 173.25), (std::vector<double>{80, 100, 120, 140, 160}));
-  EXPECT_EQ(legend_ticks(-140, -60), (std::vector<double>{-140, -120, -100, -80, -60}));
-  EXPECT_EQ(legend_ticks(0, 1), (std::vector<double>{0, 0.5, 1}));
-  EXPECT_EQ(legend_ticks(100, 60), (std::vector<double>{60, 80, 100})) << "reversed range, ascending ticks";
-  EXPECT_EQ(legend_ticks(7.5, 7.5), (std::vector<double>{7.5}));
-  for (const auto& [lo, hi] : {std::pair{-3.2, 1e4}, std::pair{0.001, 0.0013}, std::pair{57.6, 178.6}}) {
-    const auto t = legend_ticks(lo, hi);
-    EXPECT_GE(t.size(), 3u) << lo << " " << hi;
-    EXPECT_LE(t.size(), 6u) << lo << " " << hi;
-    EXPECT_GE(t.front(), lo - 1e-12);
-    EXPECT_LE(t.back(), hi + 1e-12);
-  }
-}
-
 TEST(OverlayPng, ValuesAreColourMappedAndNanIsTransparent) {
   io::GeoRaster r;
   r.rows = 2;
@@ -52,8 +37,8 @@ TEST(LegendPng, ShowsTheMapFromLoAtTheBottomToHiAtTheTopOnATranslucentCard) {
   const test::Image img = test::decode_png(legend_png(turbo, {"path_loss_db (dB)", "10 m above ground", 60, 170}));
   ASSERT_GT(img.width, 100);
   ASSERT_GT(img.height, 200);
-  // The bar's column, 10 pixels in: its topmost and bottommost opaque pixels are the map's ends.
-  const int x = 15;
+  // The bar's column (17 to 39 pixels in): its topmost and bottommost opaque pixels are the map's ends.
+  const int x = 25;
   int top = -1, bottom = -1;
   for (int y = 0; y < img.height; ++y) {
     const auto& p = img.at(x, y);
