@@ -19,6 +19,19 @@ std::function<std::array<int, 2>(int)> fixed_pitch(int chars, int lines) {
 // A card 150 px wide that shrinks from 420 px to 180 px at least.
 std::array<int, 2> card(int max_height) { return {150, std::clamp(max_height, 180, 420)}; }
 
+// The viewer's parts: its overlay text (5 lines of 80), its key list (19 of 78), shown.
+OverlayInput viewer_like(int width, int height) {
+  OverlayInput in;
+  in.width = width;
+  in.height = height;
+  in.slider_height = 92;
+  in.text = fixed_pitch(80, 5);
+  in.keys = fixed_pitch(78, 19);
+  in.keys_shown = true;
+  in.legend = card;
+  return in;
+}
+
 // Strictly overlapping interiors, written out here rather than with overlap().
 bool share_area(const Box& a, const Box& b) {
   const int w = std::min(a.x + a.w, b.x + b.w) - std::max(a.x, b.x);
@@ -27,14 +40,7 @@ bool share_area(const Box& a, const Box& b) {
 }
 
 TEST(OverlayLayout, At1280x720EverythingFitsAtItsLargestFont) {
-  OverlayInput in;
-  in.width = 1280;
-  in.height = 720;
-  in.slider_height = 92;
-  in.text = fixed_pitch(80, 5);
-  in.keys = fixed_pitch(78, 19);
-  in.keys_shown = true;
-  in.legend = card;
+  const OverlayInput in = viewer_like(1280, 720);
   const OverlayLayout l = lay_out_overlay(in);
   EXPECT_EQ(l.slider.x, 1280 - 8 - 460);
   EXPECT_EQ(l.slider.y, 720 - 8 - 92);
@@ -52,14 +58,7 @@ TEST(OverlayLayout, At1280x720EverythingFitsAtItsLargestFont) {
 }
 
 TEST(OverlayLayout, NarrowWindowsShrinkTheFontsAndTinyOnesLeaveTextOut) {
-  OverlayInput in;
-  in.width = 800;
-  in.height = 600;
-  in.slider_height = 92;
-  in.text = fixed_pitch(80, 5);
-  in.keys = fixed_pitch(78, 19);
-  in.keys_shown = true;
-  in.legend = card;
+  OverlayInput in = viewer_like(800, 600);
   const OverlayLayout l = lay_out_overlay(in);
   EXPECT_LT(l.text_font, 15);
   EXPECT_LE(l.text.right(), l.legend.x - 8);
