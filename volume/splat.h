@@ -127,7 +127,8 @@ Volume signal_from_path_loss(const Volume& path_loss, double erp_w);
 
 struct SplatRunOptions {
   std::filesystem::path executable = "/usr/bin/splat";
-  std::filesystem::path sdf_folder;  // .sdf or .sdf.bz2 tiles, named as io/sdf_name.h accepts
+  std::filesystem::path sdf_folder;  // .sdf tiles, compressed or not (.sdf.gz, .sdf.bz2, ...),
+                                     // named as io/sdf_name.h accepts
   SplatSite site;                    // the transmitter
   SplatLrp lrp;                      // its model parameters (the ERP is not passed to SPLAT!)
   std::vector<double> heights_agl;   // receiver heights, metres above ground (-L), >= 0

@@ -301,7 +301,7 @@ void add_splat_command(CLI::App& app) {
   cmd->add_option("--lrp", o->lrp,
                   "SPLAT! .lrp file for --qth (default: the .qth's name with .lrp)");
   cmd->add_option("--sdf", o->sdf,
-                  "Folder of SDF tiles (.sdf or .sdf.bz2, e.g. ../shared/data/dem/utah_sdf)");
+                  "Folder of SDF tiles (.sdf, or compressed: .sdf.gz, .sdf.bz2, .sdf.xz, .sdf.zip; e.g. ../shared/data/dem/utah_sdf)");
   cmd->add_option("--import", o->imports,
                   "Stack existing SPLAT! -ano path-loss files instead of running SPLAT!");
   cmd->add_option("-o,--output", o->output, "The .vdb file to write")->required();

@@ -4,6 +4,9 @@
 
 #include <fstream>
 
+#include "compress.h"
+#include "io/compressed.h"
+#include "io/dem_file.h"
 #include "run_command.h"
 #include "shared_data.h"
 
@@ -151,6 +154,38 @@ TEST(InfoCli, UtahSdfDirectoryIsOneMosaic) {
   EXPECT_EQ(j["gap_samples"], 0);
 }
 
+// SPLAT! terrain as meshtastic-site-planner ships it: gzip-compressed SDF tiles in a folder.
+TEST(InfoCli, GzippedSdfTilesAndTheirFolderReadLikeTheOriginals) {
+  const auto a = test::shared_dem("utah_sdf/40_41_111_112.sdf.bz2"), b = test::shared_dem("utah_sdf/40_41_112_113.sdf.bz2");
+  TERRAVOL_REQUIRE_SHARED(a);
+  TERRAVOL_REQUIRE_SHARED(b);
+  test::TempDir dir;
+  for (const auto& p : {a, b}) {
+    const std::string name(io::strip_compression(p.filename().string()));
+    test::write_file_bytes(dir.path() / (name + ".gz"), test::gzip_bytes(io::read_content(p)));
+  }
+  const auto tile = dir.path() / "40_41_111_112.sdf.gz";
+  const auto r = run_terravol("info " + tile.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("SPLAT! SDF, gzip-compressed"), std::string::npos) << r.out;
+  auto gz = info_json(tile.string())["tiles"][0], bz2 = info_json(a.string())["tiles"][0];
+  EXPECT_EQ(gz["compression"], "gzip");
+  EXPECT_EQ(bz2["compression"], "bzip2");
+  for (auto* j : {&gz, &bz2}) {
+    j->erase("path");
+    j->erase("compression");
+  }
+  EXPECT_EQ(gz, bz2);
+  auto folder = info_json(dir.path().string()), originals = info_json(a.string() + " " + b.string());
+  EXPECT_EQ(folder["tiles"].size(), 2u);
+  EXPECT_EQ(folder["rows"], 1200);
+  EXPECT_EQ(folder["cols"], 2400);
+  EXPECT_EQ(folder["gap_samples"], 0);
+  folder.erase("tiles");
+  originals.erase("tiles");
+  EXPECT_EQ(folder, originals);
+}
+
 // Bad input: one line "terravol: FILE: what is wrong", exit status 1 or 2, and no hang (the
 // 10 s bound is a hang guard; it takes about 0.1 s, more under load).
 void expect_clean_failure(const std::string& args, const std::string& must_mention) {
@@ -171,6 +206,9 @@ TEST(InfoCli, BadInputFailsCleanlyWithOneLine) {
   std::ofstream(p("junk.tif")) << "II*\0garbage";
   std::ofstream(p("short.hgt.gz")) << "\x1f\x8b\x08\x00";
   std::ofstream(p("notes.txt")) << "hello";
+  std::ofstream(p("40_41_111_112.sdf.gz")) << "BZh91AY&SY";
+  std::ofstream(p("cut.sdf.xz"), std::ios::binary) << std::string("\xfd" "7zXZ\0\0\4", 8);
+  std::ofstream(p("junk.dt1.zip")) << "PK\3\4 not really";
   expect_clean_failure("info " + p("N10E010.hgt"), "N10E010.hgt: size 1000 bytes");
   expect_clean_failure("info " + p("garbage.dt1"), "garbage.dt1: ");
   expect_clean_failure("info " + p("huge.asc"), "huge.asc: ");
@@ -178,6 +216,9 @@ TEST(InfoCli, BadInputFailsCleanlyWithOneLine) {
   expect_clean_failure("info " + p("junk.tif"), "junk.tif: ");
   expect_clean_failure("info " + p("short.hgt.gz"), "short.hgt.gz: ");
   expect_clean_failure("info " + p("notes.txt"), "notes.txt: unknown DEM format");
+  expect_clean_failure("info " + p("40_41_111_112.sdf.gz"), "40_41_111_112.sdf.gz: named .gz but holds bzip2 data");
+  expect_clean_failure("info " + p("cut.sdf.xz"), "cut.sdf.xz: xz data is truncated");
+  expect_clean_failure("info " + p("junk.dt1.zip"), "junk.dt1.zip: not a readable zip archive");
   expect_clean_failure("info " + p("missing.hgt"), "missing.hgt: ");
   expect_clean_failure("info --crs utm:99X " + p("trunc.asc"), "--crs");
 }
