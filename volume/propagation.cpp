@@ -42,6 +42,14 @@
 //    transmitter. The slant distance is clamped to 1 m.
 //  - The line in latitude and longitude departs from the geodesic by metres over tens of km,
 //    far less than a DEM sample.
+//  - Antenna pattern (antenna.h), a per-path term: the loss grows by the pattern's attenuation
+//    in the path's azimuth (the geodesic's at the transmitter) and departure elevation. The
+//    departure is the first leg of the path the construction traces, the string from the
+//    transmitter stretched over the knife edges to the receiver: the steepest of the lines from
+//    the transmitter to the edges and to the receiver (their elevation above the local
+//    horizontal of the k-factor Earth). SPLAT! (PlotLRPath) instead takes the line to the first
+//    terrain sample above the line of sight; on a diffracted path the two differ by up to the
+//    angle between the first obstruction and the highest edge.
 #include "volume/propagation.h"
 
 #include <GeographicLib/Geodesic.hpp>
@@ -67,6 +75,7 @@ namespace {
 constexpr double kEarthRadius = 6371000.0;       // metres (ITU-R P.526's a)
 constexpr double kSpeedOfLight = 299792458.0;    // m/s
 constexpr double kDipoleGainDbi = 2.15;          // half-wave dipole over isotropic
+constexpr double kDegree = M_PI / 180.0;
 
 std::string num(double v) {
   char b[40];
@@ -78,8 +87,10 @@ std::string num(double v) {
 // (terrain already raised by the bulge; y[a] and y[b] are the ends: antennas at the top level,
 // edges below). edge_a / edge_b: that end is a knife edge, so the samples joined to it by
 // unbroken obstruction of this path (v > -0.78 from the end inward) belong to its obstacle and
-// are not edges of their own.
-double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool edge_b, double lambda, int depth) {
+// are not edges of their own. Each edge used is appended to `edges` when given (sample = its
+// index in x, y).
+double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool edge_b, double lambda, int depth,
+               std::vector<KnifeEdge>* edges, int level = 1) {
   if (b - a < 2 || depth < 1) return 0.0;
   const double xa = x[a], ya = y[a], xb = x[b];
   const double length = xb - xa;
@@ -109,9 +120,10 @@ double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool
   const double v2 = best_key * 2.0 * length / lambda;
   const double v = best_key < 0.0 ? -std::sqrt(-v2) : std::sqrt(v2);
   const double principal = knife_edge_loss_db(v);
+  if (edges) edges->push_back({static_cast<std::size_t>(best), v, principal, level});
   if (depth == 1) return principal;
-  return principal + deygout(x, y, a, best, edge_a, true, lambda, depth - 1) +
-         deygout(x, y, best, b, true, edge_b, lambda, depth - 1);
+  return principal + deygout(x, y, a, best, edge_a, true, lambda, depth - 1, edges, level + 1) +
+         deygout(x, y, best, b, true, edge_b, lambda, depth - 1, edges, level + 1);
 }
 
 double wavelength(double frequency_mhz) { return kSpeedOfLight / (frequency_mhz * 1e6); }
@@ -165,11 +177,104 @@ void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions
   if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
 }
 
+void check_dem(const io::Grid& dem) {
+  if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
+    throw std::invalid_argument("the DEM must be a geographic grid of at least 2 x 2 samples");
+  }
+}
+
+void check_inside(const DemExtent& e, double lat, double lon, const std::string& what) {
+  if (lat < e.south || lat > e.north || lon < e.west || lon > e.east) {
+    throw std::invalid_argument(what + " at " + num(lat) + ", " + num(lon) + " lies outside the DEM (" + num(e.south) +
+                                ".." + num(e.north) + " N, " + num(e.west) + ".." + num(e.east) + " E)");
+  }
+}
+
 std::vector<double> default_heights() {
   std::vector<double> h;
   for (int n = 0; n <= 40; ++n) h.push_back(50.0 * n);
   return h;
 }
+
+// The model's geometry for one transmitter: every path is built and evaluated here, for
+// compute_rf_rows and rf_path alike.
+class PathModel {
+ public:
+  PathModel(const io::Grid& dem, const Transmitter& tx, const RfOptions& options)
+      : tx_(tx), options_(options), ground_(dem), geod_(GeographicLib::Geodesic::WGS84()) {
+    const io::SceneFrame frame(tx.lat, tx.lon);
+    step_m_ = std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
+    lambda_ = wavelength(tx.frequency_mhz);
+    two_ka_ = 2.0 * options.k_factor * kEarthRadius;
+    tx_top_ = ground_(tx.lat, tx.lon) + tx.height_agl;
+  }
+
+  // A receiver column: x = distances and y = terrain raised by the bulge, both of segments + 1
+  // entries, x[0] = 0, y[0] = the transmitter's top, x[segments] = distance; y[segments] is the
+  // receiver's top, set by loss().
+  struct Column {
+    double distance = 0.0, azimuth = 0.0, rx_ground = 0.0;
+    int segments = 0;
+  };
+  Column column(double rx_lat, double rx_lon, std::vector<double>& x, std::vector<double>& y) const {
+    Column c;
+    double azi2 = 0.0;
+    geod_.Inverse(tx_.lat, tx_.lon, rx_lat, rx_lon, c.distance, c.azimuth, azi2);
+    c.segments = std::max(1, static_cast<int>(std::ceil(c.distance / step_m_)));
+    x.resize(static_cast<std::size_t>(c.segments) + 1);
+    y.resize(static_cast<std::size_t>(c.segments) + 1);
+    x[0] = 0.0;
+    y[0] = tx_top_;
+    for (int m = 1; m < c.segments; ++m) {
+      const double t = static_cast<double>(m) / c.segments;
+      const double d = t * c.distance;
+      x[m] = d;
+      y[m] = ground_(tx_.lat + t * (rx_lat - tx_.lat), tx_.lon + t * (rx_lon - tx_.lon)) + d * (c.distance - d) / two_ka_;
+    }
+    x[c.segments] = c.distance;
+    c.rx_ground = ground_(rx_lat, rx_lon);
+    return c;
+  }
+
+  struct Loss {
+    double free_space = 0.0, diffraction = 0.0, gain = 0.0, departure = 0.0;
+    double total() const { return free_space + diffraction - gain; }
+  };
+  // The loss to a receiver `rx_top` metres above the datum in column c. `edges` receives
+  // Deygout's edges when given; they are needed (and found) anyway with an antenna pattern.
+  Loss loss(const Column& c, const std::vector<double>& x, std::vector<double>& y, double rx_top,
+            std::vector<KnifeEdge>* edges) const {
+    y[c.segments] = rx_top;
+    const double dh = rx_top - tx_top_;
+    const double slant = std::max(1.0, std::sqrt(c.distance * c.distance + dh * dh));
+    Loss l;
+    l.free_space = free_space_loss_db(slant, tx_.frequency_mhz);
+    if (edges) edges->clear();
+    l.diffraction = deygout(x.data(), y.data(), 0, c.segments, false, false, lambda_, options_.edge_depth, edges);
+    if (edges || tx_.antenna) {
+      // The steepest line from the transmitter, in the raised frame, less the tilt of the
+      // transmitter's local horizontal there (the bulge's slope at d = 0).
+      double slope = c.distance > 0.0 ? dh / c.distance : 0.0;
+      if (edges) {
+        for (const KnifeEdge& e : *edges) slope = std::max(slope, (y[e.sample] - tx_top_) / x[e.sample]);
+      }
+      l.departure = (std::atan(slope) - std::atan(c.distance / two_ka_)) / kDegree;
+      if (tx_.antenna) l.gain = tx_.antenna->gain_db(c.azimuth < 0.0 ? c.azimuth + 360.0 : c.azimuth, l.departure);
+    }
+    return l;
+  }
+
+  double tx_top() const { return tx_top_; }
+  double ground(double lat, double lon) const { return ground_(lat, lon); }
+  double two_ka() const { return two_ka_; }
+
+ private:
+  const Transmitter& tx_;
+  const RfOptions& options_;
+  DemSampler ground_;
+  const GeographicLib::Geodesic& geod_;
+  double step_m_ = 0.0, lambda_ = 0.0, two_ka_ = 0.0, tx_top_ = 0.0;
+};
 
 }  // namespace
 
@@ -195,7 +300,8 @@ double diffraction_loss_db(const PathProfile& p, double frequency_mhz, double k_
   }
   x[n] = p.distance_m;
   y[n] = p.rx_height_m;
-  return deygout(x.data(), y.data(), 0, static_cast<int>(n), false, false, wavelength(frequency_mhz), edge_depth);
+  return deygout(x.data(), y.data(), 0, static_cast<int>(n), false, false, wavelength(frequency_mhz), edge_depth,
+                 nullptr);
 }
 
 double path_loss_db(const PathProfile& p, double frequency_mhz, double k_factor, int edge_depth) {
@@ -210,111 +316,127 @@ double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km) {
   return dem_spacing_arcsec * std::max(1.0, std::ceil(wanted_m / dem_m - 1e-9));
 }
 
-RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
-  check_parameters(tx, grid_in, options);
-  if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
-    throw std::invalid_argument("the DEM must be a geographic grid of at least 2 x 2 samples");
-  }
-  const io::Georef& g = dem.georef;
-  const double west = g.x0, east = g.x0 + (dem.cols - 1) * g.dx;
-  const double north = g.y0, south = g.y0 - (dem.rows - 1) * g.dy;
-  if (tx.lat < south || tx.lat > north || tx.lon < west || tx.lon > east) {
-    throw std::invalid_argument("transmitter at " + num(tx.lat) + ", " + num(tx.lon) + " lies outside the DEM (" +
-                                num(south) + ".." + num(north) + " N, " + num(west) + ".." + num(east) + " E)");
-  }
-  RfGrid grid = grid_in;
-  if (grid.heights_agl.empty()) grid.heights_agl = default_heights();
-  if (grid.spacing_arcsec == 0.0) grid.spacing_arcsec = default_spacing_arcsec(g.dy * 3600.0, grid.radius_km);
+RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec) {
+  RfGrid r = grid;
+  if (r.heights_agl.empty()) r.heights_agl = default_heights();
+  if (r.spacing_arcsec == 0.0) r.spacing_arcsec = default_spacing_arcsec(dem_spacing_arcsec, r.radius_km);
+  return r;
+}
 
-  RfResult result;
+DemExtent dem_extent(const io::Georef& g, int rows, int cols) {
+  return {g.y0 - (rows - 1) * g.dy, g.y0, g.x0, g.x0 + (cols - 1) * g.dx};
+}
+
+RfBox rf_box(const DemExtent& e, const Transmitter& tx, const RfGrid& grid, double anchor_lat, double anchor_lon) {
   const io::SceneFrame frame(tx.lat, tx.lon);
   const double mlat = frame.metres_per_degree_lat(), mlon = frame.metres_per_degree_lon();
   const double s = grid.spacing_arcsec / 3600.0;
   const double radius_m = grid.radius_km * 1000.0;
-  const int n_lon = static_cast<int>(std::floor(radius_m / (s * mlon) + 1e-9));
-  const int n_lat = static_cast<int>(std::floor(radius_m / (s * mlat) + 1e-9));
   constexpr double eps = 1e-9;
-  const int i_lo = std::max(-n_lon, static_cast<int>(std::ceil((west - tx.lon) / s - eps)));
-  const int i_hi = std::min(n_lon, static_cast<int>(std::floor((east - tx.lon) / s + eps)));
-  const int j_lo = std::max(-n_lat, static_cast<int>(std::ceil((south - tx.lat) / s - eps)));
-  const int j_hi = std::min(n_lat, static_cast<int>(std::floor((north - tx.lat) / s + eps)));
-  if (i_lo != -n_lon || i_hi != n_lon || j_lo != -n_lat || j_hi != n_lat) {
-    result.notes.push_back("the box was clipped to the DEM's extent");
-  }
-
-  Volume& loss = result.path_loss;
-  loss.name = "path_loss_db";
-  loss.units = "dB";
-  loss.frame.kind = FrameKind::kGeographic;
-  loss.frame.height = HeightRef::kGround;
+  const double half_lon = std::floor(radius_m / (s * mlon) + eps) * s;
+  const double half_lat = std::floor(radius_m / (s * mlat) + eps) * s;
+  // Box indices relative to the anchor; with the transmitter as the anchor these are
+  // -n .. n (the half sides are whole steps).
+  const int i_box_lo = static_cast<int>(std::ceil((tx.lon - half_lon - anchor_lon) / s - eps));
+  const int i_box_hi = static_cast<int>(std::floor((tx.lon + half_lon - anchor_lon) / s + eps));
+  const int j_box_lo = static_cast<int>(std::ceil((tx.lat - half_lat - anchor_lat) / s - eps));
+  const int j_box_hi = static_cast<int>(std::floor((tx.lat + half_lat - anchor_lat) / s + eps));
+  const int i_lo = std::max(i_box_lo, static_cast<int>(std::ceil((e.west - anchor_lon) / s - eps)));
+  const int i_hi = std::min(i_box_hi, static_cast<int>(std::floor((e.east - anchor_lon) / s + eps)));
+  const int j_lo = std::max(j_box_lo, static_cast<int>(std::ceil((e.south - anchor_lat) / s - eps)));
+  const int j_hi = std::min(j_box_hi, static_cast<int>(std::floor((e.north - anchor_lat) / s + eps)));
+  RfBox box;
+  box.clipped = i_lo != i_box_lo || i_hi != i_box_hi || j_lo != j_box_lo || j_hi != j_box_hi;
   const auto& heights = grid.heights_agl;
   const int nh = static_cast<int>(heights.size());
-  Lattice& l = loss.lattice;
+  Lattice& l = box.lattice;
   l.dims = {i_hi - i_lo + 1, j_hi - j_lo + 1, nh};
-  l.origin = {tx.lon + i_lo * s, tx.lat + j_lo * s, heights[0]};
+  l.origin = {anchor_lon + i_lo * s, anchor_lat + j_lo * s, heights[0]};
   l.spacing = {s, s, nh > 1 ? heights[1] - heights[0] : 1.0};
+  if (l.dims[0] < 1 || l.dims[1] < 1) {
+    throw std::invalid_argument("the box around the transmitter at " + num(tx.lat) + ", " + num(tx.lon) +
+                                " holds no lattice column inside the DEM");
+  }
   if (static_cast<double>(l.dims[0]) * l.dims[1] * l.dims[2] > static_cast<double>(kMaxPoints)) {
     throw std::invalid_argument("the lattice " + std::to_string(l.dims[0]) + " x " + std::to_string(l.dims[1]) + " x " +
                                 std::to_string(nh) + " is too large (at most 2^28 points): use a coarser spacing");
   }
-  loss.values.assign(l.size(), 0.0f);
-  loss.active_points = l.size();
-  loss.attributes = {
-      {"tx_lat", num(tx.lat)},
-      {"tx_lon", num(tx.lon)},
-      {"tx_height_agl_m", num(tx.height_agl)},
-      {"frequency_mhz", num(tx.frequency_mhz)},
-      {"k_factor", num(options.k_factor)},
-      {"model", "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " +
-                    std::to_string(options.edge_depth) + " levels, earth bulge with k = " + num(options.k_factor)},
-      {"vertical_datum", dem.vertical_datum},
-  };
-  if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
+  return box;
+}
 
-  const DemSampler ground(dem);
-  const double step_m = std::min(g.dx * mlon, g.dy * mlat);
-  const double lambda = wavelength(tx.frequency_mhz);
-  const double two_ka = 2.0 * options.k_factor * kEarthRadius;
-  const double tx_top = ground(tx.lat, tx.lon) + tx.height_agl;
-  const GeographicLib::Geodesic& geod = GeographicLib::Geodesic::WGS84();
-  const std::size_t n_columns = static_cast<std::size_t>(l.dims[0]) * static_cast<std::size_t>(l.dims[1]);
+RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double rx_lon, double rx_height_agl,
+               const RfOptions& options) {
+  RfGrid grid;
+  grid.heights_agl = {rx_height_agl};
+  check_parameters(tx, grid, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  check_inside(e, rx_lat, rx_lon, "receiver");
+  const PathModel model(dem, tx, options);
+  std::vector<double> x, y;
+  const PathModel::Column c = model.column(rx_lat, rx_lon, x, y);
+  RfPath path;
+  const double rx_top = c.rx_ground + rx_height_agl;
+  const PathModel::Loss l = model.loss(c, x, y, rx_top, &path.edges);
+  std::sort(path.edges.begin(), path.edges.end(), [](const KnifeEdge& a, const KnifeEdge& b) { return a.sample < b.sample; });
+  for (KnifeEdge& edge : path.edges) --edge.sample;  // x[0] is the transmitter
+  PathProfile& p = path.profile;
+  p.distance_m = c.distance;
+  p.tx_height_m = model.tx_top();
+  p.rx_height_m = rx_top;
+  for (int m = 1; m < c.segments; ++m) {
+    p.d_m.push_back(x[m]);
+    p.z_m.push_back(y[m] - x[m] * (c.distance - x[m]) / model.two_ka());
+  }
+  path.azimuth_deg = c.azimuth < 0.0 ? c.azimuth + 360.0 : c.azimuth;
+  path.free_space_db = l.free_space;
+  path.diffraction_db = l.diffraction;
+  path.departure_deg = l.departure;
+  path.antenna_gain_db = l.gain;
+  path.path_loss_db = l.total();
+  return path;
+}
+
+RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattice& l, std::span<const int> rows,
+                        const RfOptions& options, std::span<float> out) {
+  RfGrid grid;
+  for (int k = 0; k < l.dims[2]; ++k) grid.heights_agl.push_back(l.world(2, k));
+  check_parameters(tx, grid, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  const std::size_t nx = static_cast<std::size_t>(l.dims[0]), nr = rows.size();
+  const int nh = l.dims[2];
+  if (out.size() != nx * nr * static_cast<std::size_t>(nh)) {
+    throw std::invalid_argument("compute_rf_rows: the output holds " + std::to_string(out.size()) + " values, not " +
+                                std::to_string(nx * nr * static_cast<std::size_t>(nh)));
+  }
+  for (const int j : rows) {
+    if (j < 0 || j >= l.dims[1]) throw std::invalid_argument("compute_rf_rows: row " + std::to_string(j) + " is outside the lattice");
+  }
+  const PathModel model(dem, tx, options);
+  const std::size_t n_columns = nx * nr;
   const std::size_t layer = n_columns;
+  const bool with_edges = tx.antenna.has_value();
 
+  RfStats stats;
   std::atomic<std::size_t> done{0}, samples{0};
   std::mutex progress_mutex;
   int reported = -1;
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_columns, 64), [&](const tbb::blocked_range<std::size_t>& r) {
     std::vector<double> x, y;
+    std::vector<KnifeEdge> edges;
     std::size_t local_samples = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const int i = static_cast<int>(c % static_cast<std::size_t>(l.dims[0]));
-      const int j = static_cast<int>(c / static_cast<std::size_t>(l.dims[0]));
-      const double rx_lon = l.world(0, i), rx_lat = l.world(1, j);
-      double distance = 0.0;
-      geod.Inverse(tx.lat, tx.lon, rx_lat, rx_lon, distance);
-      const int segments = std::max(1, static_cast<int>(std::ceil(distance / step_m)));
-      x.resize(static_cast<std::size_t>(segments) + 1);
-      y.resize(static_cast<std::size_t>(segments) + 1);
-      x[0] = 0.0;
-      y[0] = tx_top;
-      for (int m = 1; m < segments; ++m) {
-        const double t = static_cast<double>(m) / segments;
-        const double d = t * distance;
-        x[m] = d;
-        y[m] = ground(tx.lat + t * (rx_lat - tx.lat), tx.lon + t * (rx_lon - tx.lon)) + d * (distance - d) / two_ka;
-      }
-      x[segments] = distance;
-      local_samples += static_cast<std::size_t>(segments - 1);
-      const double rx_ground = ground(rx_lat, rx_lon);
+      const int i = static_cast<int>(c % nx);
+      const int j = rows[c / nx];
+      const PathModel::Column column = model.column(l.world(1, j), l.world(0, i), x, y);
+      local_samples += static_cast<std::size_t>(column.segments - 1);
       for (int k = 0; k < nh; ++k) {
-        const double rx_top = rx_ground + l.world(2, k);
-        y[segments] = rx_top;
-        const double dh = rx_top - tx_top;
-        const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
-        const double value = free_space_loss_db(slant, tx.frequency_mhz) +
-                             deygout(x.data(), y.data(), 0, segments, false, false, lambda, options.edge_depth);
-        loss.values[c + layer * static_cast<std::size_t>(k)] = static_cast<float>(value);
+        const PathModel::Loss loss = model.loss(column, x, y, column.rx_ground + l.world(2, k), with_edges ? &edges : nullptr);
+        out[c + layer * static_cast<std::size_t>(k)] = static_cast<float>(loss.total());
       }
     }
     samples += local_samples;
@@ -328,59 +450,113 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
       }
     }
   });
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  result.columns = n_columns;
-  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(n_columns);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats.columns = n_columns;
+  stats.samples = samples.load();
+  return stats;
+}
 
-  if (tx.erp_w) {
-    Volume signal = loss;
-    signal.name = "signal_dbm";
-    signal.units = "dBm";
-    // ERP is relative to a half-wave dipole: EIRP = ERP + 2.15 dB; the signal is the power an
-    // isotropic (0 dBi) receiving antenna delivers.
-    const double eirp_dbm = 10.0 * std::log10(*tx.erp_w) + 30.0 + kDipoleGainDbi;
-    signal.attributes["eirp_dbm"] = num(eirp_dbm);
-    signal.attributes["signal"] = "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
-    for (float& v : signal.values) v = static_cast<float>(eirp_dbm - v);
-    result.signal = std::move(signal);
+Volume path_loss_volume(const Transmitter& tx, const Lattice& lattice, const RfOptions& options,
+                        const std::string& vertical_datum) {
+  Volume loss;
+  loss.name = "path_loss_db";
+  loss.units = "dB";
+  loss.frame.kind = FrameKind::kGeographic;
+  loss.frame.height = HeightRef::kGround;
+  loss.lattice = lattice;
+  loss.values.assign(lattice.size(), 0.0f);
+  loss.active_points = lattice.size();
+  loss.attributes = {
+      {"tx_lat", num(tx.lat)},
+      {"tx_lon", num(tx.lon)},
+      {"tx_height_agl_m", num(tx.height_agl)},
+      {"frequency_mhz", num(tx.frequency_mhz)},
+      {"k_factor", num(options.k_factor)},
+      {"model", "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " +
+                    std::to_string(options.edge_depth) + " levels, earth bulge with k = " + num(options.k_factor)},
+      {"vertical_datum", vertical_datum},
+  };
+  if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
+  if (!tx.name.empty()) loss.attributes["tx_name"] = tx.name;
+  if (tx.antenna) {
+    loss.attributes["antenna_pattern"] = tx.antenna->describe() +
+                                         "; the loss includes the pattern's attenuation along each path's departure";
   }
+  return loss;
+}
+
+Volume signal_from_path_loss(Volume s, double erp_w) {
+  if (!(erp_w > 0.0) || !std::isfinite(erp_w)) throw std::invalid_argument("signal_from_path_loss: ERP must be > 0 W");
+  s.name = "signal_dbm";
+  s.units = "dBm";
+  // ERP is relative to a half-wave dipole: EIRP = ERP + 2.15 dB; the signal is the power an
+  // isotropic (0 dBi) receiving antenna delivers.
+  const double eirp_dbm = 10.0 * std::log10(erp_w) + 30.0 + kDipoleGainDbi;
+  for (float& x : s.values) x = static_cast<float>(eirp_dbm - x);
+  s.background = static_cast<float>(eirp_dbm - s.background);
+  s.attributes["erp_w"] = num(erp_w);
+  s.attributes["eirp_dbm"] = num(eirp_dbm);
+  s.attributes["signal"] = "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
+  return s;
+}
+
+RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
+  check_parameters(tx, grid_in, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  const RfGrid grid = resolve_grid(grid_in, dem.georef.dy * 3600.0);
+  const RfBox box = rf_box(e, tx, grid, tx.lat, tx.lon);
+  RfResult result;
+  if (box.clipped) result.notes.push_back("the box was clipped to the DEM's extent");
+  result.path_loss = path_loss_volume(tx, box.lattice, options, dem.vertical_datum);
+  std::vector<int> rows(static_cast<std::size_t>(box.lattice.dims[1]));
+  for (std::size_t j = 0; j < rows.size(); ++j) rows[j] = static_cast<int>(j);
+  const RfStats stats = compute_rf_rows(dem, tx, box.lattice, rows, options, result.path_loss.values);
+  result.seconds = stats.seconds;
+  result.columns = stats.columns;
+  result.mean_profile_samples = static_cast<double>(stats.samples) / static_cast<double>(stats.columns);
+  if (tx.erp_w) result.signal = signal_from_path_loss(result.path_loss, *tx.erp_w);
   return result;
+}
+
+RfWindow read_rf_window(const io::Mosaic& dem, const DemExtent& box) {
+  const io::Georef& g = dem.georef();
+  const int r0 = std::max(0, static_cast<int>(std::floor((g.y0 - (box.north + 2.0 * g.dy)) / g.dy)));
+  const int r1 = std::min(dem.rows() - 1, static_cast<int>(std::ceil((g.y0 - (box.south - 2.0 * g.dy)) / g.dy)));
+  const int c0 = std::max(0, static_cast<int>(std::floor((box.west - 2.0 * g.dx - g.x0) / g.dx)));
+  const int c1 = std::min(dem.cols() - 1, static_cast<int>(std::ceil((box.east + 2.0 * g.dx - g.x0) / g.dx)));
+  if (r1 <= r0 || c1 <= c0) throw std::invalid_argument("the area lies outside the DEM");
+  RfWindow w;
+  w.grid = dem.read_window(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
+  const std::size_t voids = io::count(w.grid, io::Sample::kVoid), outside = io::count(w.grid, io::Sample::kOutside);
+  io::fill_voids(w.grid);
+  if (voids + outside > 0) {
+    w.notes.push_back(std::to_string(voids) + " void and " + std::to_string(outside) +
+                      " uncovered DEM samples were filled by interpolation");
+  }
+  for (const auto& t : dem.tiles()) {
+    if (t.row0 + t.rows <= r0 || t.row0 > r1 || t.col0 + t.cols <= c0 || t.col0 > c1) continue;
+    w.tiles += (w.tiles.empty() ? "" : ", ") + t.path.filename().string();
+  }
+  return w;
+}
+
+DemExtent rf_area(const Transmitter& tx, double radius_km) {
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double half_lat = radius_km * 1000.0 / frame.metres_per_degree_lat();
+  const double half_lon = radius_km * 1000.0 / frame.metres_per_degree_lon();
+  return {tx.lat - half_lat, tx.lat + half_lat, tx.lon - half_lon, tx.lon + half_lon};
 }
 
 RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
   check_parameters(tx, grid, options);
-  const io::Georef& g = dem.georef();
-  const double west = g.x0, east = g.x0 + (dem.cols() - 1) * g.dx;
-  const double north = g.y0, south = g.y0 - (dem.rows() - 1) * g.dy;
-  if (tx.lat < south || tx.lat > north || tx.lon < west || tx.lon > east) {
-    throw std::invalid_argument("transmitter at " + num(tx.lat) + ", " + num(tx.lon) + " lies outside the DEM (" +
-                                num(south) + ".." + num(north) + " N, " + num(west) + ".." + num(east) + " E)");
-  }
-  const io::SceneFrame frame(tx.lat, tx.lon);
-  const double half_lat = grid.radius_km * 1000.0 / frame.metres_per_degree_lat() + 2.0 * g.dy;
-  const double half_lon = grid.radius_km * 1000.0 / frame.metres_per_degree_lon() + 2.0 * g.dx;
-  const int r0 = std::max(0, static_cast<int>(std::floor((g.y0 - (tx.lat + half_lat)) / g.dy)));
-  const int r1 = std::min(dem.rows() - 1, static_cast<int>(std::ceil((g.y0 - (tx.lat - half_lat)) / g.dy)));
-  const int c0 = std::max(0, static_cast<int>(std::floor((tx.lon - half_lon - g.x0) / g.dx)));
-  const int c1 = std::min(dem.cols() - 1, static_cast<int>(std::ceil((tx.lon + half_lon - g.x0) / g.dx)));
-  io::Grid window = dem.read_window(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
-  const std::size_t voids = io::count(window, io::Sample::kVoid), outside = io::count(window, io::Sample::kOutside);
-  io::fill_voids(window);
-
-  RfGrid resolved = grid;
-  if (resolved.spacing_arcsec == 0.0) resolved.spacing_arcsec = default_spacing_arcsec(g.dy * 3600.0, grid.radius_km);
-  RfResult result = compute_rf(window, tx, resolved, options);
-  if (voids + outside > 0) {
-    result.notes.push_back(std::to_string(voids) + " void and " + std::to_string(outside) +
-                           " uncovered DEM samples were filled by interpolation");
-  }
-  std::string tiles;
-  for (const auto& t : dem.tiles()) {
-    if (t.row0 + t.rows <= r0 || t.row0 > r1 || t.col0 + t.cols <= c0 || t.col0 > c1) continue;
-    tiles += (tiles.empty() ? "" : ", ") + t.path.filename().string();
-  }
-  result.path_loss.attributes["dem"] = tiles;
-  if (result.signal) result.signal->attributes["dem"] = tiles;
+  check_inside(dem_extent(dem.georef(), dem.rows(), dem.cols()), tx.lat, tx.lon, "transmitter");
+  RfWindow window = read_rf_window(dem, rf_area(tx, grid.radius_km));
+  RfResult result = compute_rf(window.grid, tx, resolve_grid(grid, dem.georef().dy * 3600.0), options);
+  result.notes.insert(result.notes.end(), window.notes.begin(), window.notes.end());
+  result.path_loss.attributes["dem"] = window.tiles;
+  if (result.signal) result.signal->attributes["dem"] = window.tiles;
   return result;
 }
 

@@ -4,13 +4,16 @@
 // top of propagation.cpp and in docs/architecture.md ("volume/").
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "io/grid.h"
 #include "io/mosaic.h"
+#include "volume/antenna.h"
 #include "volume/volume.h"
 
 namespace terravol::volume {
@@ -20,6 +23,11 @@ struct Transmitter {
   double height_agl = 30.0;      // antenna height above the ground under it, metres, >= 0
   double frequency_mhz = 900.0;  // (0, 100000]; the model is meant for about 30 MHz .. 10 GHz
   std::optional<double> erp_w;   // effective radiated power relative to a half-wave dipole, W, > 0
+                                 // (in the pattern's strongest direction, given one)
+  std::string name;              // a label (legends, grid names); may be empty
+  // The transmitting antenna's pattern; none: the ERP in every direction. With one, each path's
+  // loss grows by the pattern's attenuation along its departure direction (RfPath).
+  std::optional<AntennaPattern> antenna;
 };
 
 // The receiver lattice: longitude x latitude x height above ground, centred on the
@@ -86,14 +94,106 @@ double path_loss_db(const PathProfile& profile, double frequency_mhz, double k_f
 // at most 256 intervals across the box's north-south side (6" for a 20 km radius over SRTM3).
 double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km);
 
+// The grid with its defaults filled in: heights 0, 50, ..., 2000 when empty, the default
+// spacing over a DEM of `dem_spacing_arcsec` (latitude) when 0.
+RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec);
+
+// A DEM's extent: the first and last sample positions, degrees.
+struct DemExtent {
+  double south = 0.0, north = 0.0, west = 0.0, east = 0.0;
+};
+DemExtent dem_extent(const io::Georef& georef, int rows, int cols);
+
+// The receiver lattice of one transmitter: longitudes anchor_lon + i s and latitudes
+// anchor_lat + j s (s = grid.spacing_arcsec / 3600) within radius_km of the transmitter in each
+// direction (metres per degree at its latitude), clipped to the extent; heights grid.heights_agl.
+// With the transmitter as its own anchor this is compute_rf's lattice, centred on it.
+// Precondition: a resolved grid (resolve_grid). `clipped` tells whether the extent cut the box.
+struct RfBox {
+  Lattice lattice;
+  bool clipped = false;
+};
+RfBox rf_box(const DemExtent& extent, const Transmitter& tx, const RfGrid& grid, double anchor_lat, double anchor_lon);
+
+// One knife edge of Deygout's construction on a path.
+struct KnifeEdge {
+  std::size_t sample = 0;  // index into the path's PathProfile::d_m / z_m
+  double v = 0.0;          // Fresnel-Kirchhoff parameter on the (sub-)path it was found on
+  double loss_db = 0.0;    // J(v)
+  int level = 1;           // 1: the principal edge, 2: a secondary one, ...
+};
+
+// One transmitter-receiver path exactly as compute_rf computes it (the same profile, the same
+// arithmetic): path_loss_db is the value compute_rf stores at that receiver.
+struct RfPath {
+  PathProfile profile;          // terrain samples above the datum, without the bulge
+  double azimuth_deg = 0.0;     // of the geodesic at the transmitter, clockwise from true north
+  double free_space_db = 0.0, diffraction_db = 0.0;
+  std::vector<KnifeEdge> edges; // Deygout's edges, ordered along the path
+  // Elevation of the path's first leg at the transmitter, degrees above its local horizontal
+  // (k-factor Earth): the steepest of the lines to the edges and to the receiver, i.e. the
+  // first leg of the string stretched over the edges.
+  double departure_deg = 0.0;
+  double antenna_gain_db = 0.0;  // the pattern's gain (<= 0) at (azimuth, departure); 0 without
+  double path_loss_db = 0.0;     // free_space_db + diffraction_db - antenna_gain_db
+};
+
+// The path from tx to a receiver height_agl metres above the ground at (lat, lon), over a
+// geographic DEM grid that holds the path (fill voids first). Throws std::invalid_argument for
+// bad parameters and a transmitter or receiver outside the grid.
+RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double rx_lon, double rx_height_agl,
+               const RfOptions& options = {});
+
+// What a computation did.
+struct RfStats {
+  std::size_t columns = 0;       // receiver columns computed
+  std::size_t samples = 0;       // terrain profile samples taken, all columns
+  double seconds = 0.0;          // wall time
+};
+
+// The path loss (dB, float) at the lattice points of `rows` (indices j into the lattice's
+// latitude axis, any order), every height and longitude: out[i + nx (r + R k)] for the r-th of
+// the R rows, so all rows in order give the lattice's own layout. Parallel (TBB) over the columns.
+// Precondition: out.size() == nx * R * nz; the grid holds the lattice's columns. Throws
+// std::invalid_argument for bad parameters (as compute_rf).
+RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattice& lattice,
+                        std::span<const int> rows, const RfOptions& options, std::span<float> out);
+
+// The volume compute_rf returns for tx on `lattice` before its values are set: "path_loss_db",
+// dB, geographic frame with heights above ground, values 0, and the attributes (transmitter,
+// model, the DEM's vertical datum).
+Volume path_loss_volume(const Transmitter& tx, const Lattice& lattice, const RfOptions& options,
+                        const std::string& vertical_datum);
+
+// The signal grid of a path-loss volume as compute_rf makes it: "signal_dbm", dBm, EIRP (ERP +
+// 2.15 dB, ERP relative to a half-wave dipole) minus path loss, in float; NaN stays NaN.
+// Attributes erp_w, eirp_dbm and signal are added. Precondition: erp_w > 0
+// (std::invalid_argument).
+Volume signal_from_path_loss(Volume path_loss, double erp_w);
+
 // The model over a geographic DEM grid (row 0 north). Every sample's height is used as it is,
 // so fill voids first (io::fill_voids). Parallel (TBB) over receiver columns.
 // Throws std::invalid_argument for bad parameters (naming them) and a transmitter outside the
 // grid.
 RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options = {});
 
-// The same over a mosaic: reads the window the box needs (plus a margin), fills its voids and
-// gaps (noted in RfResult::notes), and records the tiles in the volumes' attributes.
+// The same over a mosaic: reads the window the box needs (rf_area, read_rf_window), and records
+// the tiles in the volumes' attributes ("dem").
 RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options = {});
+
+// The area (degrees) within radius_km of the transmitter in each direction, metres per degree
+// at its latitude: what its box may cover.
+DemExtent rf_area(const Transmitter& tx, double radius_km);
+
+// The samples of a mosaic covering `area` plus two samples on each side (clipped to the mosaic),
+// voids and gaps filled (io::fill_voids; said in notes), and the names of the tiles it overlaps.
+// Throws std::invalid_argument when the area misses the mosaic, io::FormatError for tiles that
+// fail to load.
+struct RfWindow {
+  io::Grid grid;
+  std::vector<std::string> notes;
+  std::string tiles;  // "N45E006.hgt, ..."
+};
+RfWindow read_rf_window(const io::Mosaic& dem, const DemExtent& area);
 
 }  // namespace terravol::volume

@@ -51,7 +51,6 @@ using text::strip_comment;
 using text::to_number;
 using text::trim;
 
-constexpr double kDipoleGainDbi = 2.15;  // as volume/propagation.cpp: EIRP = ERP + 2.15 dB
 constexpr double kSplatDipoleGainDbi = 2.14;  // SPLAT!'s own (PlotLRPath: "ERP + 2.14")
 constexpr double kFeet = 0.3048;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -401,22 +400,6 @@ AnoStack stack_ano(const std::vector<AnoLayer>& layers, int cells_per_degree) {
     for (const char o : kept_obstructed) out.obstructed += static_cast<std::size_t>(o);
   }
   return out;
-}
-
-Volume signal_from_path_loss(const Volume& path_loss, double erp_w) {
-  if (!(erp_w > 0.0) || !std::isfinite(erp_w))
-    throw std::invalid_argument("signal_from_path_loss: ERP must be > 0 W");
-  Volume s = path_loss;
-  s.name = "signal_dbm";
-  s.units = "dBm";
-  const double eirp_dbm = 10.0 * std::log10(erp_w) + 30.0 + kDipoleGainDbi;
-  for (float& x : s.values) x = static_cast<float>(eirp_dbm - x);
-  s.background = static_cast<float>(eirp_dbm - s.background);
-  s.attributes["erp_w"] = num(erp_w);
-  s.attributes["eirp_dbm"] = num(eirp_dbm);
-  s.attributes["signal"] =
-      "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
-  return s;
 }
 
 // ---- running SPLAT! ----

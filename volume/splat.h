@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "volume/antenna.h"
+#include "volume/propagation.h"
 #include "volume/volume.h"
 
 namespace terravol::volume {
@@ -121,10 +122,7 @@ struct AnoStack {
 AnoStack stack_ano(const std::vector<AnoLayer>& layers,
                    int cells_per_degree = kSplatCellsPerDegree);
 
-// The signal grid of a path-loss volume as `terravol rf` computes it: "signal_dbm", dBm,
-// EIRP (ERP + 2.15 dB, ERP relative to a half-wave dipole) minus path loss; NaN stays NaN.
-// Precondition: erp_w > 0 (std::invalid_argument).
-Volume signal_from_path_loss(const Volume& path_loss, double erp_w);
+// The signal grid of a stacked path-loss volume: signal_from_path_loss (propagation.h).
 
 struct SplatRunOptions {
   std::filesystem::path executable = "/usr/bin/splat";

@@ -571,7 +571,7 @@ TEST(Geometry, PropagationVolumeOverTheBundledDem) {
   grid.radius_km = 4.0;
   grid.spacing_arcsec = 9.0;
   grid.heights_agl = {0.0, 100.0, 200.0, 300.0, 400.0, 500.0};
-  const Volume v = compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 900.0, std::nullopt}, grid).path_loss;
+  const Volume v = compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}}, grid).path_loss;
   const GroundFunction ground = bilinear_ground(dem);
   const io::SceneFrame frame(45.5, 6.5);
   const LatticeMapper mapper(v, frame, ground);

@@ -174,7 +174,7 @@ TEST(DiffractionProperty, SymmetricNonNegativeAndGrowingWithDepth) {
 
 TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  Transmitter tx{45.5, 6.5, 200.0, 900.0, std::nullopt};
+  Transmitter tx{45.5, 6.5, 200.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 8.0;
   grid.spacing_arcsec = 30.0;
@@ -197,7 +197,7 @@ TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
 
 TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
   const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 25.0;
   grid.spacing_arcsec = 15.0;
@@ -220,7 +220,7 @@ TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
 TEST(Rf, LossGrowsBehindARidge) {
   // A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of the transmitter.
   const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 12.0;
   grid.spacing_arcsec = 30.0;
@@ -247,7 +247,7 @@ TEST(Rf, LossGrowsBehindARidge) {
 
 TEST(Rf, SignalIsEirpMinusPathLoss) {
   const io::Grid dem = synthetic_dem([](double lat, double lon) { return 500.0 + 300.0 * std::sin(40.0 * lat) * std::cos(50.0 * lon); });
-  const Transmitter tx{45.5, 6.5, 30.0, 450.0, 50.0};
+  const Transmitter tx{45.5, 6.5, 30.0, 450.0, 50.0, {}, {}};
   RfGrid grid;
   grid.radius_km = 5.0;
   grid.spacing_arcsec = 20.0;
@@ -261,12 +261,12 @@ TEST(Rf, SignalIsEirpMinusPathLoss) {
   for (std::size_t n = 0; n < r.path_loss.values.size(); ++n) {
     EXPECT_NEAR(r.signal->values[n], eirp - r.path_loss.values[n], 1e-4);
   }
-  EXPECT_FALSE(compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 450.0, std::nullopt}, grid).signal);
+  EXPECT_FALSE(compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 450.0, std::nullopt, {}, {}}, grid).signal);
 }
 
 TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  const Transmitter centre{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  const Transmitter centre{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 20.0;
   grid.heights_agl = {};
@@ -283,7 +283,7 @@ TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
   EXPECT_TRUE(r.notes.empty());
   EXPECT_EQ(r.path_loss.frame, parse_frame("geographic-agl"));
 
-  const Transmitter corner{45.05, 6.03, 10.0, 900.0, std::nullopt};
+  const Transmitter corner{45.05, 6.03, 10.0, 900.0, std::nullopt, {}, {}};
   const RfResult c = compute_rf(flat, corner, grid);
   ASSERT_EQ(c.notes.size(), 1u);
   EXPECT_GE(c.path_loss.lattice.origin[0], 6.0);
@@ -295,7 +295,7 @@ TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
 
 TEST(Rf, RejectsBadParameters) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  const Transmitter tx{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  const Transmitter tx{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 0.0;
   EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
@@ -303,9 +303,9 @@ TEST(Rf, RejectsBadParameters) {
   grid.heights_agl = {10.0, 20.0, 40.0};
   EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
   grid.heights_agl = {10.0};
-  EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt}, grid), std::invalid_argument);
-  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt}, grid), std::invalid_argument);
-  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt, {}, {}}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt, {}, {}}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0, {}, {}}, grid), std::invalid_argument);
 }
 
 TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
@@ -315,7 +315,7 @@ TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
   grid.radius_km = 3.0;
   grid.spacing_arcsec = 15.0;
   grid.heights_agl = {0.0, 100.0, 200.0};
-  const RfResult r = compute_rf(mosaic, Transmitter{45.5, 6.5, 30.0, 900.0, 50.0}, grid);
+  const RfResult r = compute_rf(mosaic, Transmitter{45.5, 6.5, 30.0, 900.0, 50.0, {}, {}}, grid);
   EXPECT_EQ(r.path_loss.attributes.at("dem"), "N45E006.hgt");
   EXPECT_EQ(r.path_loss.attributes.at("tx_lat"), "45.5");
   const std::string bytes = encode_vdb({&r.path_loss, &*r.signal});
