@@ -148,7 +148,9 @@ class DemSampler {
   const io::Grid& g_;
 };
 
-void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
+}  // namespace
+
+void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
   auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
   if (!std::isfinite(tx.lat) || std::abs(tx.lat) > 85.0) bad("transmitter latitude " + num(tx.lat) + ": must be within [-85, 85]");
   if (!std::isfinite(tx.lon) || std::abs(tx.lon) > 360.0) bad("transmitter longitude " + num(tx.lon) + ": must be within [-360, 360]");
@@ -176,6 +178,8 @@ void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions
   if (!std::isfinite(options.k_factor) || options.k_factor <= 0.0) bad("k-factor " + num(options.k_factor) + ": must be > 0");
   if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
 }
+
+namespace {
 
 void check_dem(const io::Grid& dem) {
   if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
@@ -368,7 +372,7 @@ RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double
                const RfOptions& options) {
   RfGrid grid;
   grid.heights_agl = {rx_height_agl};
-  check_parameters(tx, grid, options);
+  check_rf_parameters(tx, grid, options);
   check_dem(dem);
   const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
   check_inside(e, tx.lat, tx.lon, "transmitter");
@@ -402,7 +406,7 @@ RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattic
                         const RfOptions& options, std::span<float> out) {
   RfGrid grid;
   for (int k = 0; k < l.dims[2]; ++k) grid.heights_agl.push_back(l.world(2, k));
-  check_parameters(tx, grid, options);
+  check_rf_parameters(tx, grid, options);
   check_dem(dem);
   const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
   check_inside(e, tx.lat, tx.lon, "transmitter");
@@ -501,7 +505,7 @@ Volume signal_from_path_loss(Volume s, double erp_w) {
 }
 
 RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
-  check_parameters(tx, grid_in, options);
+  check_rf_parameters(tx, grid_in, options);
   check_dem(dem);
   const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
   check_inside(e, tx.lat, tx.lon, "transmitter");
@@ -550,7 +554,7 @@ DemExtent rf_area(const Transmitter& tx, double radius_km) {
 }
 
 RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
-  check_parameters(tx, grid, options);
+  check_rf_parameters(tx, grid, options);
   check_inside(dem_extent(dem.georef(), dem.rows(), dem.cols()), tx.lat, tx.lon, "transmitter");
   RfWindow window = read_rf_window(dem, rf_area(tx, grid.radius_km));
   RfResult result = compute_rf(window.grid, tx, resolve_grid(grid, dem.georef().dy * 3600.0), options);

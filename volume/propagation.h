@@ -94,6 +94,10 @@ double path_loss_db(const PathProfile& profile, double frequency_mhz, double k_f
 // at most 256 intervals across the box's north-south side (6" for a 20 km radius over SRTM3).
 double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km);
 
+// Throws std::invalid_argument("what: must be ...") for a parameter out of range: the checks
+// every function here makes.
+void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options);
+
 // The grid with its defaults filled in: heights 0, 50, ..., 2000 when empty, the default
 // spacing over a DEM of `dem_spacing_arcsec` (latitude) when 0.
 RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec);

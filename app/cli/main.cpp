@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "app/cli/commands.h"
+#include "app/cli/mpi_session.h"
 #include "bench/bench_command.h"
 #include "io/error.h"
 
@@ -28,6 +29,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const terravol::app::cli::QuietFailure&) {
+    return 1;  // another MPI rank printed why
   } catch (const terravol::io::FormatError& e) {
     std::fprintf(stderr, "terravol: %s\n", e.what());
     return 1;
