@@ -320,6 +320,11 @@ double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km) {
   return dem_spacing_arcsec * std::max(1.0, std::ceil(wanted_m / dem_m - 1e-9));
 }
 
+double dem_height(const io::Grid& dem, double lat, double lon) {
+  check_dem(dem);
+  return DemSampler(dem)(lat, lon);
+}
+
 RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec) {
   RfGrid r = grid;
   if (r.heights_agl.empty()) r.heights_agl = default_heights();

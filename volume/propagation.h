@@ -148,6 +148,10 @@ struct RfPath {
 RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double rx_lon, double rx_height_agl,
                const RfOptions& options = {});
 
+// The ground the model takes at (lat, lon), metres above the DEM's datum: bilinear between the
+// grid's samples, clamped to its edges. Precondition: a geographic grid of at least 2 x 2.
+double dem_height(const io::Grid& dem, double lat, double lon);
+
 // What a computation did.
 struct RfStats {
   std::size_t columns = 0;       // receiver columns computed
