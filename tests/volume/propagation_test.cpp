@@ -308,6 +308,94 @@ TEST(Rf, RejectsBadParameters) {
   EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0, {}, {}}, grid), std::invalid_argument);
 }
 
+TEST(RfPath, EqualsComputeRfAtItsLatticePoints) {
+  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 500.0 + 300.0 * std::sin(40.0 * lat) * std::cos(50.0 * lon); });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 20.0;
+  grid.heights_agl = {0.0, 100.0, 200.0};
+  const Volume v = compute_rf(dem, tx, grid).path_loss;
+  std::mt19937 rng(1717);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int i = std::uniform_int_distribution<int>(0, v.lattice.dims[0] - 1)(rng);
+    const int j = std::uniform_int_distribution<int>(0, v.lattice.dims[1] - 1)(rng);
+    const int k = std::uniform_int_distribution<int>(0, 2)(rng);
+    const RfPath p = rf_path(dem, tx, v.lattice.world(1, j), v.lattice.world(0, i), v.lattice.world(2, k));
+    ASSERT_EQ(static_cast<float>(p.path_loss_db), v.at(i, j, k)) << i << " " << j << " " << k;
+    EXPECT_NEAR(p.path_loss_db, p.free_space_db + p.diffraction_db, 1e-9);
+    EXPECT_NEAR(p.diffraction_db, diffraction_loss_db(p.profile, 900.0), 1e-9);
+    double edges = 0.0;
+    for (std::size_t e = 0; e < p.edges.size(); ++e) {
+      edges += p.edges[e].loss_db;
+      if (e > 0) {
+        EXPECT_LT(p.edges[e - 1].sample, p.edges[e].sample);
+      }
+    }
+    EXPECT_NEAR(edges, p.diffraction_db, 1e-9);
+    EXPECT_LE(p.edges.size(), 3u);
+  }
+}
+
+TEST(RfPath, DepartureIsTheSteepestLegAboveTheTransmittersHorizon) {
+  // Over flat ground the path is clear: the departure is the line to the receiver, less the
+  // Earth's curvature, by hand: atan((h_rx - h_tx) / D) - atan(D / (2 k a)).
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  const Transmitter tx{45.5, 6.5, 40.0, 900.0, std::nullopt, {}, {}};
+  const RfPath clear = rf_path(flat, tx, 45.5, 6.6, 300.0);
+  ASSERT_TRUE(clear.edges.empty());
+  const double D = geodesic_m(45.5, 6.5, 45.5, 6.6);
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  EXPECT_NEAR(clear.departure_deg, (std::atan(260.0 / D) - std::atan(D / two_ka)) * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(clear.azimuth_deg, 90.0, 0.1);
+  // Behind a 400 m ridge 4 km east the path leaves towards the ridge's top, well above the
+  // line to a low receiver beyond it.
+  const io::Grid ridge = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
+  const RfPath behind = rf_path(ridge, tx, 45.5, 6.65, 10.0);
+  ASSERT_FALSE(behind.edges.empty());
+  const std::size_t e = behind.edges.front().sample;
+  const double d = behind.profile.d_m[e], Db = behind.profile.distance_m;
+  const double raised = behind.profile.z_m[e] + d * (Db - d) / two_ka;
+  EXPECT_NEAR(behind.departure_deg, (std::atan((raised - 40.0) / d) - std::atan(Db / two_ka)) * 180.0 / M_PI, 1e-9);
+  EXPECT_GT(behind.departure_deg, 4.0);
+}
+
+TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  Transmitter tx{45.5, 6.5, 40.0, 900.0, 10.0, {}, {}};
+  AntennaPattern pattern;
+  pattern.azimuth = parse_az("0\n0 1\n90 0.5\n180 0.1\n270 0.5\n", "t.az").first;
+  pattern.elevation = parse_el("0 0\n-10 1\n0 1\n10 0.2\n", "t.el").cut;
+  RfGrid grid;
+  grid.radius_km = 3.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {10.0, 510.0};
+  const Volume plain = compute_rf(flat, tx, grid).path_loss;
+  tx.antenna = pattern;
+  const RfResult with = compute_rf(flat, tx, grid);
+  EXPECT_NE(with.path_loss.attributes.at("antenna_pattern").find("t.az:t.el"), std::string::npos);
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  const Lattice& l = plain.lattice;
+  int checked = 0;
+  for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < l.dims[1]; ++j) {
+      for (int i = 0; i < l.dims[0]; ++i) {
+        double D = 0.0, azi1 = 0.0, azi2 = 0.0;
+        GeographicLib::Geodesic::WGS84().Inverse(45.5, 6.5, l.world(1, j), l.world(0, i), D, azi1, azi2);
+        if (D < 1.0) continue;
+        // Flat ground, clear paths: the departure is the line to the receiver (by hand).
+        const double departure = (std::atan((l.world(2, k) - 40.0) / D) - std::atan(D / two_ka)) * 180.0 / M_PI;
+        const double gain = pattern.gain_db(azi1 < 0.0 ? azi1 + 360.0 : azi1, departure);
+        EXPECT_NEAR(with.path_loss.at(i, j, k) - plain.at(i, j, k), -gain, 2e-4) << i << " " << j << " " << k;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+  // The signal follows: ERP in the pattern's strongest direction, less the pattern elsewhere.
+  EXPECT_NEAR(with.signal->values[5] + with.path_loss.values[5], 10.0 * std::log10(10.0) + 30.0 + 2.15, 1e-3);
+}
+
 TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
   const auto dem = std::filesystem::path(TERRAVOL_SOURCE_DIR) / "data" / "dem" / "N45E006.hgt";
   const io::Mosaic mosaic = io::Mosaic::open({dem});
