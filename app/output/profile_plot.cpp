@@ -2,7 +2,6 @@
 #include "app/output/profile_plot.h"
 
 #include <vtkAxis.h>
-#include <vtkBrush.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
 #include <vtkContextScene.h>
@@ -127,8 +126,7 @@ std::vector<std::uint8_t> profile_png(const volume::LinkProfile& l, const std::s
   area->SetInputArray(1, "c1");
   area->SetInputArray(2, "c2");
   area->SetLabel("terrain + bulge");
-  area->GetBrush()->SetColor(166, 134, 96, 255);
-  area->SetColor(120, 95, 60, 255);
+  area->SetColor(166, 134, 96, 255);  // vtkPlotArea fills with the plot's colour
   add_line(chart, "line of sight", km, los, {200, 30, 30}, 2.0f);
   add_line(chart, "first Fresnel zone", km, upper, {40, 90, 200}, 1.5f);
   add_line(chart, "", km, lower, {40, 90, 200}, 1.5f)->SetLegendVisibility(false);
