@@ -96,8 +96,10 @@ void run_splat_volume(const SplatCommandOptions& o) {
   std::optional<volume::SplatSite> site;
   volume::SplatLrp lrp;
   bool have_lrp = false;
+  std::optional<volume::AntennaPattern> antenna;
   if (!o.tx.empty()) {
     const volume::Transmitter tx = parse_tx(o.tx);
+    antenna = tx.antenna;
     if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
       throw std::runtime_error("--tx " + o.tx +
                                ": SPLAT! takes frequencies within [20, 20000] MHz");
@@ -164,6 +166,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     run.radius_km = o.radius_km;
     run.timeout_seconds = o.timeout_seconds;
     run.keep_ano_texts = !o.ano_dir.empty();
+    run.antenna = antenna;
     const bool show_progress = !o.quiet && ::isatty(2);
     if (show_progress) {
       run.progress = [n = heights.size()](std::size_t done) {
@@ -182,6 +185,10 @@ void run_splat_volume(const SplatCommandOptions& o) {
     attributes["model"] =
         "SPLAT! " + (r.version.empty() ? std::string("(version unknown)") : "v" + r.version) +
         " area path loss (ITWOM), splat -L H -R " + fmt(o.radius_km) + " -metric -erp 0";
+    if (antenna) {
+      attributes["model"] += " -dbm, with the antenna pattern";
+      attributes["antenna_pattern"] = antenna->describe() + "; the loss includes the pattern's attenuation (SPLAT!'s)";
+    }
     attributes["radius_km"] = fmt(o.radius_km);
     attributes["dem"] = tiles;
     summary = "SPLAT! " + r.version + ": " + std::to_string(heights.size()) + " runs in " +
@@ -256,9 +263,9 @@ void add_splat_command(CLI::App& app) {
                                  "written as .vdb");
   auto o = std::make_shared<SplatCommandOptions>();
   cmd->add_option("--tx", o->tx,
-                  "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]] as for terravol rf (default "
-                  "900 MHz; an ERP adds "
-                  "a signal_dbm grid); SPLAT!'s other parameters are its defaults");
+                  "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,pattern=FILE.az[:FILE.el]][,azimuth=DEG]"
+                  "[,tilt=DEG] as for terravol rf (default 900 MHz; an ERP adds a signal_dbm grid; the pattern "
+                  "goes to SPLAT! as tx.az/tx.el); SPLAT!'s other parameters are its defaults");
   cmd->add_option("--qth", o->qth, "Transmitter as a SPLAT! .qth file (instead of --tx)");
   cmd->add_option("--lrp", o->lrp,
                   "SPLAT! .lrp file for --qth (default: the .qth's name with .lrp)");
