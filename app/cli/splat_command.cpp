@@ -184,9 +184,9 @@ void run_splat_volume(const SplatCommandOptions& o) {
     for (const auto& t : r.tiles) tiles += (tiles.empty() ? "" : ", ") + t;
     attributes["model"] =
         "SPLAT! " + (r.version.empty() ? std::string("(version unknown)") : "v" + r.version) +
-        " area path loss (ITWOM), splat -L H -R " + fmt(o.radius_km) + " -metric -erp 0";
+        " area path loss (ITWOM), splat -L H -R " + fmt(o.radius_km) + " -metric " +
+        (antenna ? "-erp " + fmt(lrp.erp_w.value_or(1.0)) + " -dbm (dBm turned back into loss)" : "-erp 0");
     if (antenna) {
-      attributes["model"] += " -dbm, with the antenna pattern";
       attributes["antenna_pattern"] = antenna->describe() + "; the loss includes the pattern's attenuation (SPLAT!'s)";
     }
     attributes["radius_km"] = fmt(o.radius_km);
