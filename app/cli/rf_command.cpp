@@ -1,6 +1,6 @@
 // `terravol rf --tx LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,...] [--tx ...] --dem DEM... -o out.vdb`:
 // path-loss volumes from the built-in propagation model (volume/propagation.h) for one
-// transmitter, or signal volumes and the best server for several (volume/coverage.h), written
+// transmitter, or signal volumes and the best server for several (volume/plan.h), written
 // as OpenVDB. Under mpirun the rows of the transmitters' boxes are dealt out over the ranks;
 // rank 0 gathers them and writes (app/mpi_session.h).
 #include <tbb/global_control.h>
@@ -24,7 +24,7 @@
 #include "app/cli/mpi_session.h"
 #include "app/cli/rf_args.h"
 #include "io/mosaic.h"
-#include "volume/coverage.h"
+#include "volume/plan.h"
 #include "volume/propagation.h"
 #include "volume/vdb_write.h"
 
@@ -129,7 +129,7 @@ void print_lattice(const volume::Lattice& l) {
 }
 
 // Rank 0: the volumes, written, and what they hold.
-void write_results(const RfCommandOptions& o, const volume::CoveragePlan& plan, std::vector<volume::Volume> losses,
+void write_results(const RfCommandOptions& o, const volume::RfPlan& plan, std::vector<volume::Volume> losses,
                    const volume::RfWindow& window) {
   for (auto& v : losses) v.attributes["dem"] = window.tiles;
   const std::string out = o.output.string();
@@ -197,7 +197,7 @@ void run_rf(const RfCommandOptions& o) {
   // Every rank checks, reads and computes its share; failures are agreed on before gathering,
   // so that no rank waits for one that has given up.
   std::string error;
-  std::optional<volume::CoveragePlan> plan;
+  std::optional<volume::RfPlan> plan;
   volume::RfWindow window;
   volume::RowShare share;
   std::vector<float> values;
@@ -220,8 +220,8 @@ void run_rf(const RfCommandOptions& o) {
                                  fmt(extent.north) + " N, " + fmt(extent.west) + ".." + fmt(extent.east) + " E)");
       }
     }
-    plan = volume::plan_coverage(extent, g.dy * 3600.0, std::move(setup.transmitters), setup.grid, options);
-    window = volume::read_rf_window(mosaic, volume::coverage_area(*plan));
+    plan = volume::plan_rf(extent, g.dy * 3600.0, std::move(setup.transmitters), setup.grid, options);
+    window = volume::read_rf_window(mosaic, volume::plan_area(*plan));
     share = volume::share_of(*plan, mpi.rank(), mpi.size());
     if (show_progress) {
       options.progress = [](double f) { std::fprintf(stderr, "\rrf: %3d%%", static_cast<int>(100.0 * f)); };
@@ -245,7 +245,7 @@ void run_rf(const RfCommandOptions& o) {
   }
   std::vector<volume::Volume> losses;
   try {
-    volume::CoverageAssembler assembler(*plan, options, window.grid.vertical_datum);
+    volume::PlanAssembler assembler(*plan, options, window.grid.vertical_datum);
     assembler.add(share, values);
     values = {};
     for (int r = 1; r < mpi.size(); ++r) {

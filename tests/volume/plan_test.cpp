@@ -1,7 +1,7 @@
 // Several transmitters: the plan's boxes against compute_rf's, any split over ranks giving the
 // same bits as computing each transmitter alone, and the best server against a brute-force
 // search over the transmitters in world coordinates.
-#include "volume/coverage.h"
+#include "volume/plan.h"
 
 #include <gtest/gtest.h>
 
@@ -57,9 +57,9 @@ std::vector<Transmitter> three() {
           tx(45.5 - 5 * kStep, 6.5 + 14 * kStep, 80.0, "c")};
 }
 
-TEST(CoveragePlan, BoxesAreEachTransmittersOwnOnOneGrid) {
+TEST(RfPlan, BoxesAreEachTransmittersOwnOnOneGrid) {
   const io::Grid dem = hills();
-  const CoveragePlan plan = plan_coverage(kExtent, 3.0, three(), small_grid());
+  const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid());
   ASSERT_EQ(plan.boxes.size(), 3u);
   for (std::size_t t = 0; t < 3; ++t) {
     const RfResult alone = compute_rf(dem, plan.transmitters[t], small_grid());
@@ -76,27 +76,27 @@ TEST(CoveragePlan, BoxesAreEachTransmittersOwnOnOneGrid) {
   EXPECT_TRUE(plan.notes.empty());
 }
 
-TEST(CoveragePlan, RejectsWhatTheModelRejects) {
-  EXPECT_THROW(plan_coverage(kExtent, 3.0, {}, small_grid()), std::invalid_argument);
+TEST(RfPlan, RejectsWhatTheModelRejects) {
+  EXPECT_THROW(plan_rf(kExtent, 3.0, {}, small_grid()), std::invalid_argument);
   auto bad = three();
   bad[1].lat = 50.0;
-  EXPECT_THROW(plan_coverage(kExtent, 3.0, bad, small_grid()), std::invalid_argument);
+  EXPECT_THROW(plan_rf(kExtent, 3.0, bad, small_grid()), std::invalid_argument);
   bad = three();
   bad[2].frequency_mhz = -1.0;
-  EXPECT_THROW(plan_coverage(kExtent, 3.0, bad, small_grid()), std::invalid_argument);
+  EXPECT_THROW(plan_rf(kExtent, 3.0, bad, small_grid()), std::invalid_argument);
   auto corner = three();
   corner[2].lat = 45.005;
-  EXPECT_EQ(plan_coverage(kExtent, 3.0, corner, small_grid()).notes.size(), 1u);
+  EXPECT_EQ(plan_rf(kExtent, 3.0, corner, small_grid()).notes.size(), 1u);
 }
 
-TEST(CoverageShares, EveryRowOnceAndSplitsGiveTheBitsOfOneProcess) {
+TEST(PlanShares, EveryRowOnceAndSplitsGiveTheBitsOfOneProcess) {
   const io::Grid dem = hills();
-  const CoveragePlan plan = plan_coverage(kExtent, 3.0, three(), small_grid());
+  const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid());
   std::vector<std::vector<float>> alone;
   for (const Transmitter& t : plan.transmitters) alone.push_back(compute_rf(dem, t, small_grid()).path_loss.values);
   for (const int ranks : {1, 2, 3, 5}) {
     SCOPED_TRACE(ranks);
-    CoverageAssembler assembler(plan, {}, "");
+    PlanAssembler assembler(plan, {}, "");
     std::size_t values = 0;
     // Ranks in reverse: the assembler does not care about the order.
     for (int r = ranks - 1; r >= 0; --r) {
@@ -119,10 +119,10 @@ TEST(CoverageShares, EveryRowOnceAndSplitsGiveTheBitsOfOneProcess) {
   }
 }
 
-TEST(CoverageShares, AssemblerRefusesWrongOrMissingShares) {
+TEST(PlanShares, AssemblerRefusesWrongOrMissingShares) {
   const io::Grid dem = hills();
-  const CoveragePlan plan = plan_coverage(kExtent, 3.0, three(), small_grid());
-  CoverageAssembler assembler(plan, {}, "");
+  const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid());
+  PlanAssembler assembler(plan, {}, "");
   const RowShare share = share_of(plan, 0, 2);
   const std::vector<float> v = compute_share(dem, plan, share, {});
   EXPECT_THROW(assembler.add(share, std::span<const float>(v).first(v.size() - 1)), std::invalid_argument);
@@ -134,9 +134,9 @@ TEST(CoverageShares, AssemblerRefusesWrongOrMissingShares) {
 
 TEST(BestServer, IsTheStrongestCoveringTransmitterFoundByBruteForce) {
   const io::Grid dem = hills();
-  const CoveragePlan plan = plan_coverage(kExtent, 3.0, three(), small_grid());
+  const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid());
   std::vector<Volume> signals;
-  CoverageAssembler assembler(plan, {}, "");
+  PlanAssembler assembler(plan, {}, "");
   const RowShare all = share_of(plan, 0, 1);
   assembler.add(all, compute_share(dem, plan, all, {}));
   std::vector<Volume> losses = assembler.take();

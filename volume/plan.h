@@ -24,7 +24,7 @@ namespace terravol::volume {
 // of the first transmitter (longitudes tx0.lon + i s, latitudes tx0.lat + j s), so boxes of
 // different transmitters share their lattice points and the first transmitter's box is exactly
 // the one `terravol rf` gives it alone.
-struct CoveragePlan {
+struct RfPlan {
   std::vector<Transmitter> transmitters;  // at least one
   RfGrid grid;                            // resolved (resolve_grid)
   std::vector<Lattice> boxes;             // one per transmitter
@@ -35,7 +35,7 @@ struct CoveragePlan {
 
 // Throws std::invalid_argument for bad parameters (propagation.h's checks), no transmitter, a
 // transmitter outside the DEM, and a union lattice of more than kMaxPoints points.
-CoveragePlan plan_coverage(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
+RfPlan plan_rf(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
                            const RfGrid& grid, const RfOptions& options = {});
 
 // One rank's share of the work: rows (t, j) of the boxes, numbered transmitter by transmitter
@@ -44,24 +44,24 @@ CoveragePlan plan_coverage(const DemExtent& dem, double dem_spacing_arcsec, std:
 struct RowShare {
   std::vector<std::vector<int>> rows;  // per transmitter, increasing
   // How many values compute_share returns for this share under `plan`.
-  std::size_t values(const CoveragePlan& plan) const;
+  std::size_t values(const RfPlan& plan) const;
 };
 // Precondition: 0 <= rank < ranks (std::invalid_argument).
-RowShare share_of(const CoveragePlan& plan, int rank, int ranks);
+RowShare share_of(const RfPlan& plan, int rank, int ranks);
 
 // The path loss of a share: for each transmitter in order, compute_rf_rows over its rows
 // (that function's layout), concatenated. `progress` in options is told the fraction of the
-// share done. `dem` must hold every box (read_rf_window(coverage_area(plan))).
-std::vector<float> compute_share(const io::Grid& dem, const CoveragePlan& plan, const RowShare& share,
+// share done. `dem` must hold every box (read_rf_window(plan_area(plan))).
+std::vector<float> compute_share(const io::Grid& dem, const RfPlan& plan, const RowShare& share,
                                  const RfOptions& options, RfStats* stats = nullptr);
 
 // The area every box of the plan may cover (the union of rf_area over its transmitters).
-DemExtent coverage_area(const CoveragePlan& plan);
+DemExtent plan_area(const RfPlan& plan);
 
 // Puts shares together into one path-loss volume per transmitter (path_loss_volume).
-class CoverageAssembler {
+class PlanAssembler {
  public:
-  CoverageAssembler(const CoveragePlan& plan, const RfOptions& options, const std::string& vertical_datum);
+  PlanAssembler(const RfPlan& plan, const RfOptions& options, const std::string& vertical_datum);
   // Adds a share's values (compute_share's). Throws std::invalid_argument when the count is
   // wrong or a row was added before.
   void add(const RowShare& share, std::span<const float> values);
@@ -69,7 +69,7 @@ class CoverageAssembler {
   std::vector<Volume> take();
 
  private:
-  const CoveragePlan& plan_;
+  const RfPlan& plan_;
   std::vector<Volume> volumes_;
   std::vector<std::vector<char>> filled_;
   std::size_t missing_ = 0;
@@ -85,6 +85,6 @@ class CoverageAssembler {
 struct BestServer {
   Volume best_signal, best_server;
 };
-BestServer best_server(const CoveragePlan& plan, const std::vector<Volume>& signals);
+BestServer best_server(const RfPlan& plan, const std::vector<Volume>& signals);
 
 }  // namespace terravol::volume

@@ -1,5 +1,5 @@
-// Several transmitters, best server, and the split over ranks (coverage.h).
-#include "volume/coverage.h"
+// Several transmitters, best server, and the split over ranks (plan.h).
+#include "volume/plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,17 +19,17 @@ std::string num(double v) {
   return b;
 }
 
-std::string label(const CoveragePlan& plan, std::size_t t) {
+std::string label(const RfPlan& plan, std::size_t t) {
   const std::string& name = plan.transmitters[t].name;
   return name.empty() ? "tx" + std::to_string(t + 1) : name;
 }
 
 }  // namespace
 
-CoveragePlan plan_coverage(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
+RfPlan plan_rf(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
                            const RfGrid& grid_in, const RfOptions& options) {
   if (transmitters.empty()) throw std::invalid_argument("no transmitter");
-  CoveragePlan plan;
+  RfPlan plan;
   plan.grid = resolve_grid(grid_in, dem_spacing_arcsec);
   plan.transmitters = std::move(transmitters);
   const Transmitter& anchor = plan.transmitters.front();
@@ -70,7 +70,7 @@ CoveragePlan plan_coverage(const DemExtent& dem, double dem_spacing_arcsec, std:
   return plan;
 }
 
-std::size_t RowShare::values(const CoveragePlan& plan) const {
+std::size_t RowShare::values(const RfPlan& plan) const {
   std::size_t n = 0;
   for (std::size_t t = 0; t < rows.size(); ++t) {
     const Lattice& b = plan.boxes[t];
@@ -79,7 +79,7 @@ std::size_t RowShare::values(const CoveragePlan& plan) const {
   return n;
 }
 
-RowShare share_of(const CoveragePlan& plan, int rank, int ranks) {
+RowShare share_of(const RfPlan& plan, int rank, int ranks) {
   if (ranks < 1 || rank < 0 || rank >= ranks) {
     throw std::invalid_argument("share_of: rank " + std::to_string(rank) + " of " + std::to_string(ranks));
   }
@@ -94,7 +94,7 @@ RowShare share_of(const CoveragePlan& plan, int rank, int ranks) {
   return share;
 }
 
-DemExtent coverage_area(const CoveragePlan& plan) {
+DemExtent plan_area(const RfPlan& plan) {
   DemExtent a = rf_area(plan.transmitters.front(), plan.grid.radius_km);
   for (const Transmitter& tx : plan.transmitters) {
     const DemExtent b = rf_area(tx, plan.grid.radius_km);
@@ -106,7 +106,7 @@ DemExtent coverage_area(const CoveragePlan& plan) {
   return a;
 }
 
-std::vector<float> compute_share(const io::Grid& dem, const CoveragePlan& plan, const RowShare& share,
+std::vector<float> compute_share(const io::Grid& dem, const RfPlan& plan, const RowShare& share,
                                  const RfOptions& options, RfStats* stats) {
   if (share.rows.size() != plan.boxes.size()) throw std::invalid_argument("compute_share: the share is of another plan");
   std::vector<float> out(share.values(plan));
@@ -134,7 +134,7 @@ std::vector<float> compute_share(const io::Grid& dem, const CoveragePlan& plan, 
   return out;
 }
 
-CoverageAssembler::CoverageAssembler(const CoveragePlan& plan, const RfOptions& options,
+PlanAssembler::PlanAssembler(const RfPlan& plan, const RfOptions& options,
                                      const std::string& vertical_datum)
     : plan_(plan) {
   for (std::size_t t = 0; t < plan.boxes.size(); ++t) {
@@ -144,9 +144,9 @@ CoverageAssembler::CoverageAssembler(const CoveragePlan& plan, const RfOptions& 
   }
 }
 
-void CoverageAssembler::add(const RowShare& share, std::span<const float> values) {
+void PlanAssembler::add(const RowShare& share, std::span<const float> values) {
   if (share.rows.size() != plan_.boxes.size() || values.size() != share.values(plan_)) {
-    throw std::invalid_argument("CoverageAssembler::add: " + std::to_string(values.size()) +
+    throw std::invalid_argument("PlanAssembler::add: " + std::to_string(values.size()) +
                                 " values for a share of " + std::to_string(share.values(plan_)));
   }
   std::size_t offset = 0;
@@ -156,7 +156,7 @@ void CoverageAssembler::add(const RowShare& share, std::span<const float> values
     const std::size_t nx = static_cast<std::size_t>(b.dims[0]), nr = rows.size();
     for (const int j : rows) {
       if (j < 0 || j >= b.dims[1] || filled_[t][static_cast<std::size_t>(j)]) {
-        throw std::invalid_argument("CoverageAssembler::add: row " + std::to_string(j) + " of " + label(plan_, t) +
+        throw std::invalid_argument("PlanAssembler::add: row " + std::to_string(j) + " of " + label(plan_, t) +
                                     " is outside the box or came twice");
       }
       filled_[t][static_cast<std::size_t>(j)] = 1;
@@ -173,12 +173,12 @@ void CoverageAssembler::add(const RowShare& share, std::span<const float> values
   }
 }
 
-std::vector<Volume> CoverageAssembler::take() {
-  if (missing_ != 0) throw std::logic_error("CoverageAssembler::take: " + std::to_string(missing_) + " rows missing");
+std::vector<Volume> PlanAssembler::take() {
+  if (missing_ != 0) throw std::logic_error("PlanAssembler::take: " + std::to_string(missing_) + " rows missing");
   return std::move(volumes_);
 }
 
-BestServer best_server(const CoveragePlan& plan, const std::vector<Volume>& signals) {
+BestServer best_server(const RfPlan& plan, const std::vector<Volume>& signals) {
   if (signals.size() != plan.boxes.size()) throw std::invalid_argument("best_server: one signal per transmitter");
   for (std::size_t t = 0; t < signals.size(); ++t) {
     if (!(signals[t].lattice == plan.boxes[t])) throw std::invalid_argument("best_server: a signal is not on its box");
