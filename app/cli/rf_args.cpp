@@ -36,7 +36,7 @@ bool to_number(const std::string& text, double& out) {
 
 }  // namespace
 
-volume::Transmitter parse_tx(const std::string& text, const std::string& where_in) {
+volume::Transmitter parse_tx(const std::string& text, const std::string& where_in, const std::filesystem::path& base) {
   const std::string where = where_in.empty() ? "--tx " + text : where_in;
   auto bad = [&](const std::string& what) { throw std::runtime_error(where + ": " + what); };
   const auto parts = split(text, ',');
@@ -93,8 +93,16 @@ volume::Transmitter parse_tx(const std::string& text, const std::string& where_i
     if (azimuth || tilt) bad(std::string(azimuth ? "azimuth" : "tilt") + " needs pattern=FILE.az[:FILE.el]");
     return tx;
   }
+  std::string spec = pattern->second;
+  if (!base.empty()) {
+    const std::size_t colon = spec.find(':');
+    auto resolve = [&](const std::string& file) {
+      return file.empty() || std::filesystem::path(file).is_absolute() ? file : (base / file).string();
+    };
+    spec = colon == std::string::npos ? resolve(spec) : resolve(spec.substr(0, colon)) + ":" + resolve(spec.substr(colon + 1));
+  }
   try {
-    tx.antenna = volume::read_antenna_pattern(pattern->second, azimuth, tilt);
+    tx.antenna = volume::read_antenna_pattern(spec, azimuth, tilt);
   } catch (const std::exception& e) {
     bad(e.what());
   }
@@ -110,7 +118,8 @@ std::vector<volume::Transmitter> read_tx_file(const std::string& path) {
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
     std::size_t start = line.find_first_not_of(" \t");
     if (start == std::string::npos || line[start] == '#') continue;
-    out.push_back(parse_tx(line.substr(start), path + ": line " + std::to_string(n)));
+    out.push_back(parse_tx(line.substr(start), path + ": line " + std::to_string(n),
+                           std::filesystem::path(path).parent_path()));
   }
   if (in.bad()) throw std::runtime_error(path + ": cannot read");
   if (out.empty()) throw std::runtime_error(path + ": no transmitter (one --tx text per line)");

@@ -2,6 +2,7 @@
 // `terravol splat-volume` share. Errors are std::runtime_error with one line naming the option.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -16,12 +17,14 @@ namespace terravol::app::cli {
 //   pattern=FILE.az[:FILE.el] or pattern=:FILE.el   a SPLAT! antenna pattern (volume/antenna.h);
 //   azimuth=DEG        the pattern's rotation, replacing the .az file's (needs a .az file);
 //   tilt=DEG           the mechanical downtilt, replacing the .el file's (needs a .el file).
-// `where` names the text in messages (default "--tx TEXT"). Throws std::runtime_error
-// "WHERE: what is wrong" (a pattern file's own error follows the prefix).
-volume::Transmitter parse_tx(const std::string& text, const std::string& where = "");
+// `where` names the text in messages (default "--tx TEXT"); relative pattern file names are
+// taken relative to `base` when it is given. Throws std::runtime_error "WHERE: what is wrong" (a
+// pattern file's own error follows the prefix).
+volume::Transmitter parse_tx(const std::string& text, const std::string& where = "",
+                             const std::filesystem::path& base = {});
 
 // A file of transmitters, one --tx text per line; blank lines and lines starting with '#' are
-// skipped. Throws std::runtime_error "FILE: cannot read", "FILE: no transmitter" or
+// skipped; pattern files are relative to the file's folder. Throws std::runtime_error "FILE: cannot read", "FILE: no transmitter" or
 // "FILE: line N: what is wrong".
 std::vector<volume::Transmitter> read_tx_file(const std::string& path);
 

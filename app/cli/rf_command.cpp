@@ -178,11 +178,13 @@ void write_results(const RfCommandOptions& o, const volume::RfPlan& plan, std::v
     ++served[static_cast<std::size_t>(s) - 1];
     ++covered;
   }
+  int width = 0;
+  for (const auto& tx : plan.transmitters) width = std::max(width, static_cast<int>(tx.name.size()));
   for (std::size_t t = 0; t < signals.size(); ++t) {
     const Range r = finite_range(signals[t].values);
     const auto& b = plan.boxes[t];
-    std::printf("  %-12s %d x %d columns, signal %.1f..%.1f dBm, best server at %.1f%% of the covered points\n",
-                plan.transmitters[t].name.c_str(), b.dims[0], b.dims[1], r.lo, r.hi,
+    std::printf("  %-*s %d x %d columns, signal %.1f..%.1f dBm, best server at %.1f%% of the covered points\n",
+                width, plan.transmitters[t].name.c_str(), b.dims[0], b.dims[1], r.lo, r.hi,
                 covered ? 100.0 * static_cast<double>(served[t]) / static_cast<double>(covered) : 0.0);
   }
 }
