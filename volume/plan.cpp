@@ -27,7 +27,7 @@ std::string label(const RfPlan& plan, std::size_t t) {
 }  // namespace
 
 RfPlan plan_rf(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
-                           const RfGrid& grid_in, const RfOptions& options) {
+            const RfGrid& grid_in, const RfOptions& options) {
   if (transmitters.empty()) throw std::invalid_argument("no transmitter");
   RfPlan plan;
   plan.grid = resolve_grid(grid_in, dem_spacing_arcsec);
@@ -134,8 +134,7 @@ std::vector<float> compute_share(const io::Grid& dem, const RfPlan& plan, const 
   return out;
 }
 
-PlanAssembler::PlanAssembler(const RfPlan& plan, const RfOptions& options,
-                                     const std::string& vertical_datum)
+PlanAssembler::PlanAssembler(const RfPlan& plan, const RfOptions& options, const std::string& vertical_datum)
     : plan_(plan) {
   for (std::size_t t = 0; t < plan.boxes.size(); ++t) {
     volumes_.push_back(path_loss_volume(plan.transmitters[t], plan.boxes[t], options, vertical_datum));

@@ -36,7 +36,7 @@ struct RfPlan {
 // Throws std::invalid_argument for bad parameters (propagation.h's checks), no transmitter, a
 // transmitter outside the DEM, and a union lattice of more than kMaxPoints points.
 RfPlan plan_rf(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Transmitter> transmitters,
-                           const RfGrid& grid, const RfOptions& options = {});
+            const RfGrid& grid, const RfOptions& options = {});
 
 // One rank's share of the work: rows (t, j) of the boxes, numbered transmitter by transmitter
 // and row by row from 0; row number g belongs to rank g mod ranks. Interleaving rows keeps the

@@ -28,8 +28,8 @@
 //
 // Limits, to keep in mind when reading the numbers:
 //  - No ground reflection (no two-ray interference lobes), no clutter (trees, buildings), no
-//    atmospheric absorption, rain, ducting or tropospheric scatter; isotropic antennas at both
-//    ends, polarisation ignored. Beyond the radio horizon over smooth ground the bulge acts as
+//    atmospheric absorption, rain, ducting or tropospheric scatter; an isotropic receiving
+//    antenna, the transmitting one isotropic unless it has a pattern; polarisation ignored. Beyond the radio horizon over smooth ground the bulge acts as
 //    knife edges, not P.526's smooth-Earth method.
 //  - Knife edges: a rounded hill is a knife edge at its most obstructing sample (no
 //    rounded-obstacle term), and a flat-topped ridge is one obstacle, not two edges (its far

@@ -128,7 +128,7 @@ struct KnifeEdge {
 };
 
 // One transmitter-receiver path exactly as compute_rf computes it (the same profile, the same
-// arithmetic): path_loss_db is the value compute_rf stores at that receiver.
+// arithmetic): path_loss_db is the value compute_rf stores (as a float) at that receiver.
 struct RfPath {
   PathProfile profile;          // terrain samples above the datum, without the bulge
   double azimuth_deg = 0.0;     // of the geodesic at the transmitter, clockwise from true north
