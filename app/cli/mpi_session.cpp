@@ -26,6 +26,12 @@ void check(int code, const char* what) {
   throw std::runtime_error(std::string("MPI: ") + what + " failed (" + std::string(text, static_cast<std::size_t>(length)) + ")");
 }
 
+double all_reduce(double value, MPI_Op op) {
+  double out = 0.0;
+  check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, op, MPI_COMM_WORLD), "MPI_Allreduce");
+  return out;
+}
+
 bool launched_by_mpi() {
   for (const char* key : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"}) {
     if (std::getenv(key) != nullptr) return true;
@@ -70,19 +76,9 @@ std::string MpiSession::first_error(const std::string& error) const {
   return message;
 }
 
-double MpiSession::sum(double value) const {
-  if (!active_) return value;
-  double out = 0.0;
-  check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
-  return out;
-}
-
-double MpiSession::max(double value) const {
-  if (!active_) return value;
-  double out = 0.0;
-  check(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-  return out;
-}
+double MpiSession::sum(double value) const { return active_ ? all_reduce(value, MPI_SUM) : value; }
+double MpiSession::min(double value) const { return active_ ? all_reduce(value, MPI_MIN) : value; }
+double MpiSession::max(double value) const { return active_ ? all_reduce(value, MPI_MAX) : value; }
 
 void MpiSession::send_to_root(std::span<const float> values) const {
   for (std::size_t at = 0; at < values.size(); at += kChunk) {

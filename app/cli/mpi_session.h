@@ -38,8 +38,9 @@ class MpiSession {
   // Collective: every rank passes its error ("" when it did fine). Returns "" when every rank did
   // fine, else the message of the lowest failing rank, on every rank.
   std::string first_error(const std::string& error) const;
-  // Collective: the sum and the maximum over the ranks.
+  // Collective: the sum, the minimum and the maximum over the ranks.
   double sum(double value) const;
+  double min(double value) const;
   double max(double value) const;
   // Point to point, for gathering on rank 0 (any size; sent in chunks below 2^31 values).
   void send_to_root(std::span<const float> values) const;

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "app/cli/commands.h"
+#include "app/cli/rf_args.h"
 #include "app/output/png_output.h"
 #include "app/output/profile_plot.h"
-#include "app/cli/rf_args.h"
 #include "app/output/write_file.h"
 #include "io/mosaic.h"
 #include "volume/profile.h"
@@ -75,23 +75,6 @@ std::array<double, 3> parse_point(const std::string& text, const std::string& op
   return v;
 }
 
-std::string lower_extension(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-void check_output(const std::filesystem::path& path, const char* option, const char* ext, bool force) {
-  if (path.empty()) return;
-  const std::string s = path.string();
-  if (lower_extension(path) != ext) throw std::runtime_error(std::string(option) + " " + s + ": expected a " + ext + " file name");
-  if (!force && std::filesystem::exists(path)) throw std::runtime_error(s + ": exists (use --force to overwrite)");
-  const auto folder = path.parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
-    throw std::runtime_error(std::string(option) + " " + s + ": folder " + folder.string() + " does not exist");
-  }
-}
-
 std::string csv_text(const volume::LinkProfile& l, double tx_lat, double tx_lon, double rx_lat, double rx_lon) {
   const volume::PathProfile& p = l.path.profile;
   const volume::FresnelAnalysis& f = l.fresnel;
@@ -140,8 +123,8 @@ void run_profile(const ProfileOptions& o) {
       height < 200 || height > 8000) {
     throw std::runtime_error("--size " + o.size + ": expected WIDTHxHEIGHT, each within [200, 8000] pixels");
   }
-  check_output(o.output, "-o", ".png", o.force);
-  check_output(o.csv, "--csv", ".csv", o.force);
+  if (!o.output.empty()) output::check_output_path(o.output, "-o", ".png", o.force);
+  if (!o.csv.empty()) output::check_output_path(o.csv, "--csv", ".csv", o.force);
   double distance = 0.0;
   GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, rx[0], rx[1], distance);
   if (distance < 1.0) throw std::runtime_error("--to " + o.to + ": the same point as --from (less than 1 m away)");

@@ -114,13 +114,7 @@ void run_query(const QueryOptions& o) {
     if (!p) throw std::runtime_error("--at " + a + ": " + error);
     points.push_back(*p);
   }
-  if (!o.output.empty()) {
-    if (!o.force && std::filesystem::exists(o.output))
-      throw std::runtime_error(o.output.string() + ": exists (use --force to overwrite)");
-    const auto folder = o.output.parent_path();
-    if (!folder.empty() && !std::filesystem::is_directory(folder))
-      throw std::runtime_error("-o " + o.output.string() + ": folder " + folder.string() + " does not exist");
-  }
+  if (!o.output.empty()) output::check_output_path(o.output, "-o", "", o.force);
   volume::ReadOptions ro;
   ro.field = o.field;
   if (!o.frame.empty()) {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -23,6 +24,7 @@
 #include "app/cli/commands.h"
 #include "app/cli/mpi_session.h"
 #include "app/cli/rf_args.h"
+#include "app/output/write_file.h"
 #include "io/mosaic.h"
 #include "volume/plan.h"
 #include "volume/propagation.h"
@@ -95,15 +97,7 @@ Setup check_options(const RfCommandOptions& o) {
       }
     }
   }
-  const std::string out = o.output.string();
-  std::string ext = o.output.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".vdb") throw std::runtime_error("-o " + out + ": expected a .vdb file name");
-  if (!o.force && std::filesystem::exists(o.output)) throw std::runtime_error(out + ": exists (use --force to overwrite)");
-  const auto folder = o.output.parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
-    throw std::runtime_error("-o " + out + ": folder " + folder.string() + " does not exist");
-  }
+  output::check_output_path(o.output, "-o", ".vdb", o.force);
   s.options.k_factor = o.k_factor;
   s.options.edge_depth = o.edge_depth;
   return s;
@@ -206,6 +200,10 @@ void run_rf(const RfCommandOptions& o) {
   volume::RfStats stats;
   volume::RfOptions options;
   const bool show_progress = root && !o.quiet && ::isatty(2);
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  const auto t_start = Clock::now();
+  double read_seconds = 0.0;
   try {
     Setup setup = check_options(o);
     options = setup.options;
@@ -224,6 +222,7 @@ void run_rf(const RfCommandOptions& o) {
     }
     plan = volume::plan_rf(extent, g.dy * 3600.0, std::move(setup.transmitters), setup.grid, options);
     window = volume::read_rf_window(mosaic, volume::plan_area(*plan));
+    read_seconds = since(t_start);
     share = volume::share_of(*plan, mpi.rank(), mpi.size());
     if (show_progress) {
       options.progress = [](double f) { std::fprintf(stderr, "\rrf: %3d%%", static_cast<int>(100.0 * f)); };
@@ -240,12 +239,14 @@ void run_rf(const RfCommandOptions& o) {
   }
   const double columns = mpi.sum(static_cast<double>(stats.columns));
   const double samples = mpi.sum(static_cast<double>(stats.samples));
-  const double seconds = mpi.max(stats.seconds);
+  const double seconds = mpi.max(stats.seconds), fastest = mpi.min(stats.seconds);
+  read_seconds = mpi.max(read_seconds);
   if (!root) {
     mpi.send_to_root(values);
     return;
   }
   std::vector<volume::Volume> losses;
+  const auto t_gather = Clock::now();
   try {
     volume::PlanAssembler assembler(*plan, options, window.grid.vertical_datum);
     assembler.add(share, values);
@@ -261,9 +262,15 @@ void run_rf(const RfCommandOptions& o) {
     if (mpi.active()) mpi.abort(e.what());  // other ranks may still be sending
     throw;
   }
+  const double gather_seconds = since(t_gather);
+  const auto t_write = Clock::now();
   write_results(o, *plan, std::move(losses), window);
+  const double write_seconds = since(t_write);
   std::printf("  %.2f s, %.0f columns, %.0f profile samples each on average, %d rank%s x %d thread%s\n", seconds, columns,
               samples / std::max(1.0, columns), mpi.size(), mpi.size() == 1 ? "" : "s", threads, threads == 1 ? "" : "s");
+  std::printf("  time: options and DEM %.1f s, model %.1f s", read_seconds, seconds);
+  if (mpi.size() > 1) std::printf(" (ranks %.1f..%.1f s)", fastest, seconds);
+  std::printf(", gathering %.1f s, writing %.1f s, in all %.1f s\n", gather_seconds, write_seconds, since(t_start));
   for (const auto& n : plan->notes) std::printf("  note: %s\n", n.c_str());
   for (const auto& n : window.notes) std::printf("  note: %s\n", n.c_str());
 }

@@ -123,16 +123,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
   }
 
   const std::string out = o.output.string();
-  std::string ext = o.output.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".vdb") throw std::runtime_error("-o " + out + ": expected a .vdb file name");
-  if (!o.force && std::filesystem::exists(o.output))
-    throw std::runtime_error(out + ": exists (use --force to overwrite)");
-  const auto folder = o.output.parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
-    throw std::runtime_error("-o " + out + ": folder " + folder.string() + " does not exist");
-  }
+  output::check_output_path(o.output, "-o", ".vdb", o.force);
   if (!o.ano_dir.empty()) {
     if (!std::filesystem::is_directory(o.ano_dir))
       throw std::runtime_error("--ano-dir " + o.ano_dir.string() + ": not a folder");

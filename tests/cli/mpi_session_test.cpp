@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "temp_dir.h"
 #include "volume/readers.h"
@@ -17,10 +18,9 @@
 namespace terravol::app::cli {
 namespace {
 
+using test::bundled_dem;
 using test::run_terravol;
 using test::run_terravol_under;
-
-std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
 
 std::string mpirun(int ranks) {
   return "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "

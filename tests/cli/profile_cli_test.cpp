@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_test_util.h"
 #include "image_compare.h"
 #include "require_display.h"
 #include "run_command.h"
@@ -19,9 +20,9 @@
 namespace terravol::app::cli {
 namespace {
 
+using test::bundled_dem;
+using test::expect_one_line_error;
 using test::run_terravol;
-
-std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
 
 // 3" samples over 45.45..45.6166 N, 6.5..6.8333 E, flat at 0 m but for a 60 m north-south ridge
 // whose flat top spans 6.55..6.5525 E.
@@ -156,10 +157,7 @@ TEST(ProfileCli, BadInputFailsWithOneLineAndWritesNothing) {
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);
-    const auto r = run_terravol("profile " + args);
-    EXPECT_EQ(r.status, 1) << r.err;
-    EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+    expect_one_line_error(run_terravol("profile " + args), prefix);
   }
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
   // Never over what is there without --force.

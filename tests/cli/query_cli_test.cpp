@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "temp_dir.h"
 #include "volume/readers.h"
@@ -19,9 +20,9 @@
 namespace terravol::app::cli {
 namespace {
 
+using test::bundled_dem;
+using test::expect_one_line_error;
 using test::run_terravol;
-
-std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
 
 struct Row {
   double lat, lon, agl, ground, value;
@@ -147,10 +148,7 @@ TEST_F(QueryCli, WritesAFileAtomicallyAndBadInputFailsWithOneLine) {
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);
-    const auto r = run_terravol(args);
-    EXPECT_EQ(r.status, 1) << r.err;
-    EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+    expect_one_line_error(run_terravol(args), prefix);
   }
 }
 

@@ -16,6 +16,7 @@
 #include "shared_data.h"
 #include "temp_dir.h"
 #include "volume/splat.h"
+#include "volume_test_util.h"
 
 namespace terravol::volume {
 namespace {
@@ -144,20 +145,12 @@ TEST(AntennaPatternAgainstSplat, GainEqualsWhatSplatApplies) {
   TERRAVOL_REQUIRE_SHARED(sdf);
   if (!std::filesystem::exists("/usr/bin/splat")) GTEST_SKIP() << "/usr/bin/splat not installed (Debian package splat)";
   test::TempDir dir;
-  // A smooth sector: cardioid in azimuth every 5 degrees, a smooth beam tilted 2 degrees east.
-  std::string az = "0\n", el = "2 90\n";
-  for (int a = 0; a < 360; a += 5) {
-    const double c = 0.5 + 0.5 * std::cos(a * M_PI / 180.0);
-    az += std::to_string(a) + " " + std::to_string(0.1 + 0.9 * c * c) + "\n";
-  }
-  for (int i = -100; i <= 900; i += 5) {
-    const double e = i / 10.0;
-    el += std::to_string(e) + " " + std::to_string(std::max(0.05, std::cos(std::min(89.9, std::abs(e) * 3.0) * M_PI / 180.0))) + "\n";
-  }
+  // The smooth sector, tilted down 2 degrees towards the north.
+  const auto [az, el] = test::smooth_sector_texts();
   std::ofstream(dir.path() / "s.az") << az;
   std::ofstream(dir.path() / "s.el") << el;
   const AntennaPattern pattern = read_antenna_pattern((dir.path() / "s.az").string() + ":" + (dir.path() / "s.el").string(),
-                                                      std::nullopt, std::nullopt);
+                                                      std::nullopt, 2.0);
   SplatRunOptions run;
   run.sdf_folder = sdf;
   run.site = {"tx", 40.76, -111.89, 30.0};

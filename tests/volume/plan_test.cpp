@@ -10,24 +10,14 @@
 #include <random>
 #include <stdexcept>
 
+#include "volume_test_util.h"
+
 namespace terravol::volume {
 namespace {
 
-// A geographic 3" grid over 45..46 N, 6..7 E with smooth hills.
+// Smooth hills over 45..46 N, 6..7 E.
 io::Grid hills() {
-  io::Grid g;
-  g.format = "test";
-  g.allocate(1201, 1201);
-  g.georef.x0 = 6.0;
-  g.georef.y0 = 46.0;
-  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
-  for (int r = 0; r < g.rows; ++r) {
-    for (int c = 0; c < g.cols; ++c) {
-      const double lat = 46.0 - r / 1200.0, lon = 6.0 + c / 1200.0;
-      g.heights[g.index(r, c)] = static_cast<float>(600.0 + 250.0 * std::sin(30.0 * lat) * std::cos(40.0 * lon));
-    }
-  }
-  return g;
+  return test::synthetic_dem([](double lat, double lon) { return 600.0 + 250.0 * std::sin(30.0 * lat) * std::cos(40.0 * lon); });
 }
 
 Transmitter tx(double lat, double lon, double erp, const std::string& name) {

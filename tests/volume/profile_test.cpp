@@ -8,6 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "volume_test_util.h"
+
 namespace terravol::volume {
 namespace {
 
@@ -79,15 +81,10 @@ TEST(Fresnel, VerdictsFollowTheClearance) {
 // A 3" DEM over 45..46 N, 6..7 E, flat at 0 m but for a 60 m north-south ridge, flat-topped over
 // four samples from 6.55 E: a path along the parallel 45.5 N crosses it.
 io::Grid ridge_dem() {
-  io::Grid g;
-  g.format = "test";
-  g.allocate(1201, 1201);
-  g.georef.x0 = 6.0;
-  g.georef.y0 = 46.0;
-  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
-  for (int r = 0; r < g.rows; ++r)
-    for (int c = 0; c < g.cols; ++c) g.heights[g.index(r, c)] = c >= 660 && c <= 663 ? 60.0f : 0.0f;
-  return g;
+  return test::synthetic_dem([](double, double lon) {
+    const int c = static_cast<int>(std::lround((lon - 6.0) * 1200.0));
+    return c >= 660 && c <= 663 ? 60.0 : 0.0;
+  });
 }
 
 TEST(LinkProfile, RidgeInADemIsTheKnifeEdgeByHand) {

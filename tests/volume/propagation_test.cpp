@@ -11,27 +11,16 @@
 #include <stdexcept>
 
 #include "io/mosaic.h"
+#include "volume_test_util.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
 
 namespace terravol::volume {
 namespace {
 
-constexpr double kLambda900 = 299792458.0 / 900e6;
+using test::synthetic_dem;
 
-// A geographic 3" grid over 45..46 N, 6..7 E whose height is f(lat, lon).
-template <class F>
-io::Grid synthetic_dem(F f) {
-  io::Grid g;
-  g.format = "test";
-  g.allocate(1201, 1201);
-  g.georef.x0 = 6.0;
-  g.georef.y0 = 46.0;
-  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
-  for (int r = 0; r < g.rows; ++r)
-    for (int c = 0; c < g.cols; ++c) g.heights[g.index(r, c)] = static_cast<float>(f(46.0 - r / 1200.0, 6.0 + c / 1200.0));
-  return g;
-}
+constexpr double kLambda900 = 299792458.0 / 900e6;
 
 double geodesic_m(double lat1, double lon1, double lat2, double lon2) {
   double s = 0.0;

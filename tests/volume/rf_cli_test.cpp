@@ -8,6 +8,7 @@
 #include <vector>
 #include <string>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "temp_dir.h"
 #include "volume/readers.h"
@@ -15,17 +16,9 @@
 namespace terravol::volume {
 namespace {
 
+using test::bundled_dem;
+using test::expect_one_line_error;
 using test::run_terravol;
-
-std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
-
-void expect_one_line_error(const test::CommandResult& r, const std::string& prefix) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-  EXPECT_LT(r.seconds, 5.0);
-}
 
 TEST(RfCli, DefaultRunOnTheBundledDemWritesAReadableVdb) {
   test::TempDir dir;

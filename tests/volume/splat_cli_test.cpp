@@ -10,26 +10,22 @@
 #include <string>
 #include <vector>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "shared_data.h"
 #include "temp_dir.h"
 #include "volume/compare.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
+#include "volume_test_util.h"
 
 namespace terravol::volume {
 namespace {
 
+using test::expect_one_line_error;
 using test::run_terravol;
 
 const char kSplat[] = "/usr/bin/splat";
-
-void expect_one_line_error(const test::CommandResult& r, const std::string& prefix) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-}
 
 void write(const std::filesystem::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
@@ -142,15 +138,7 @@ TEST(SplatCli, SameAntennaPatternInSplatAndInTheBuiltInModel) {
   TERRAVOL_REQUIRE_SHARED(tiles);
   if (!std::filesystem::exists(kSplat)) GTEST_SKIP() << kSplat << " not found (Debian package splat)";
   test::TempDir dir;
-  std::string az = "0\n", el = "0 0\n";
-  for (int a = 0; a < 360; a += 5) {
-    const double c = 0.5 + 0.5 * std::cos(a * M_PI / 180.0);
-    az += std::to_string(a) + " " + std::to_string(0.05 + 0.95 * c * c) + "\n";
-  }
-  for (int i = -100; i <= 900; i += 5) {
-    const double e = i / 10.0;
-    el += std::to_string(e) + " " + std::to_string(std::max(0.1, std::cos(std::min(80.0, std::abs(e) * 4.0) * M_PI / 180.0))) + "\n";
-  }
+  const auto [az, el] = test::smooth_sector_texts();
   write(dir.path() / "s.az", az);
   write(dir.path() / "s.el", el);
   // Farnsworth Peak, pointed north-east and tilted down 3 degrees.
