@@ -108,7 +108,9 @@ void run_profile(const ProfileOptions& o) {
   volume::Transmitter tx = parse_tx(o.from, "--from " + o.from);
   const auto rx = parse_point(o.to, "--to");
   if (!(o.frequency_mhz > 0.0 && o.frequency_mhz <= 100000.0)) {
-    throw std::runtime_error("--freq " + std::to_string(o.frequency_mhz) + ": must be within (0, 100000] MHz");
+    char b[48];
+    std::snprintf(b, sizeof b, "%g", o.frequency_mhz);
+    throw std::runtime_error("--freq " + std::string(b) + ": must be within (0, 100000] MHz");
   }
   tx.frequency_mhz = o.frequency_mhz;
   volume::RfOptions options;

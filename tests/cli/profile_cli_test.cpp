@@ -148,7 +148,7 @@ TEST(ProfileCli, BadInputFailsWithOneLineAndWritesNothing) {
       {"--from 45.5,6.5,30 --to 45.5,7.6,10" + dem + csv, "--to 45.5,7.6,10: the point lies outside the DEM"},
       {"--from 45.5,6.5,30 --to 45.5,6.5,10" + dem + csv, "--to 45.5,6.5,10: the same point as --from"},
       {"--from 45.5,6.5,30 --to 45.5,6.6,10 --k-factor 4/0" + dem + csv, "--k-factor 4/0: expected a number or a fraction"},
-      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --freq 0" + dem + csv, "--freq 0"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --freq 0" + dem + csv, "--freq 0: must be within (0, 100000] MHz"},
       {"--from 45.5,6.5,30,pattern=" + (dir.path() / "no.az").string() + " --to 45.5,6.6,10" + dem + csv,
        "--from 45.5,6.5,30,pattern="},
       {"--from 45.5,6.5,30 --to 45.5,6.6,10" + dem, "give -o PROFILE.png, --csv PROFILE.csv or both"},
