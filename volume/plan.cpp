@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+
+#include "volume/text.h"
 
 namespace terravol::volume {
 
@@ -228,6 +231,31 @@ BestServer best_server(const RfPlan& plan, const std::vector<Volume>& signals) {
     }
   }
   return b;
+}
+
+std::vector<RecordedTransmitter> recorded_transmitters(const Volume& volume) {
+  std::vector<RecordedTransmitter> out;
+  const auto it = volume.attributes.find("transmitters");
+  if (it == volume.attributes.end() || text::trim(it->second).empty()) return out;
+  for (std::string_view entry : text::split_on(it->second, ';')) {
+    const std::vector<std::string_view> f = text::split_on(entry, ',');
+    RecordedTransmitter t;
+    std::optional<double> lat, lon, h;
+    if (f.size() == 4) {
+      t.name = std::string(text::trim(f[0]));
+      lat = text::to_number(text::trim(f[1]));
+      lon = text::to_number(text::trim(f[2]));
+      h = text::to_number(text::trim(f[3]));
+    }
+    if (t.name.empty() || !lat || !lon || !h || !std::isfinite(*lat) || !std::isfinite(*lon) || !std::isfinite(*h)) {
+      throw std::invalid_argument("attribute transmitters: '" + std::string(entry) + "' is not NAME,LAT,LON,HEIGHT_AGL");
+    }
+    t.lat = *lat;
+    t.lon = *lon;
+    t.height_agl = *h;
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 
 }  // namespace terravol::volume

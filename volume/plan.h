@@ -87,4 +87,15 @@ struct BestServer {
 };
 BestServer best_server(const RfPlan& plan, const std::vector<Volume>& signals);
 
+// A transmitter as a volume records it in its attribute "transmitters" (best_server above).
+struct RecordedTransmitter {
+  std::string name;
+  double lat = 0, lon = 0;  // degrees
+  double height_agl = 0;    // metres above the ground
+};
+// The volume's "transmitters", in their order (best_server's values count from 1 in it); empty
+// when it has no such attribute. Throws std::invalid_argument("attribute transmitters: ...")
+// naming the entry that is not NAME,LAT,LON,HEIGHT_AGL with finite numbers.
+std::vector<RecordedTransmitter> recorded_transmitters(const Volume& volume);
+
 }  // namespace terravol::volume

@@ -74,7 +74,10 @@ class VolumeLayer {
   void set_isosurface(std::size_t volume, std::size_t iso, const volume::IsoSpec& spec);
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
-  // slice's range, else a swatch per isosurface. Empty (no colours) when there is none.
+  // slice's range; for a "categorical" slice a swatch per category, labelled with the names of
+  // the transmitters the volume records (volume::recorded_transmitters: best_server), else with
+  // the whole numbers in the volume's range; else a swatch per isosurface. Empty (no colours)
+  // when there is none. Throws std::invalid_argument for a malformed "transmitters" attribute.
   Legend legend() const;
 
  private:

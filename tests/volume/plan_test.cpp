@@ -9,6 +9,7 @@
 #include <cstring>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include "volume_test_util.h"
 
@@ -182,6 +183,29 @@ TEST(BestServer, IsTheStrongestCoveringTransmitterFoundByBruteForce) {
   EXPECT_GT(overlap, 100u);
   for (const std::size_t n : by) EXPECT_GT(n, 100u);
   EXPECT_EQ(best.best_server.attributes.at("transmitters").substr(0, 12), "a,45.5,6.5,2");
+}
+
+TEST(RecordedTransmitters, ParsesTheAttributeInOrderAndNamesABadEntry) {
+  Volume v;
+  EXPECT_TRUE(recorded_transmitters(v).empty());
+  v.attributes["transmitters"] = "slc,40.7608,-111.891,30;east peak,40.7,-111.75,12.5";
+  const std::vector<RecordedTransmitter> t = recorded_transmitters(v);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0].name, "slc");
+  EXPECT_EQ(t[0].lat, 40.7608);
+  EXPECT_EQ(t[0].lon, -111.891);
+  EXPECT_EQ(t[0].height_agl, 30.0);
+  EXPECT_EQ(t[1].name, "east peak");
+  EXPECT_EQ(t[1].height_agl, 12.5);
+  for (const char* bad : {"slc,40.7,-111.8", "slc,40.7,x,30", ",40.7,-111.8,30", "a,1,2,3;;b,1,2,3"}) {
+    v.attributes["transmitters"] = bad;
+    try {
+      recorded_transmitters(v);
+      ADD_FAILURE() << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("attribute transmitters: '", 0), 0u) << e.what();
+    }
+  }
 }
 
 }  // namespace
