@@ -14,6 +14,7 @@
 #include "volume/colormap.h"
 #include "volume/geometry.h"
 #include "volume/plan.h"
+#include "volume/point_query.h"
 #include "volume/readers.h"
 #include "volume/reduction.h"
 
@@ -222,6 +223,17 @@ Legend VolumeLayer::legend() const {
     break;
   }
   return legend;
+}
+
+std::vector<PointValue> VolumeLayer::values_at(double lat, double lon, double height_agl, double ground_m) const {
+  std::vector<PointValue> out;
+  for (const auto& v : volumes_) {
+    if (!v->spec.visible) continue;
+    const volume::PointQuery q(v->data);
+    out.push_back({v->spec.file.filename().string() + " " + v->data.name, v->data.units,
+                   q.value(lat, lon, height_agl, ground_m)});
+  }
+  return out;
 }
 
 }  // namespace terravol::app::scene

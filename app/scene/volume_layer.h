@@ -38,6 +38,13 @@ struct Legend {
   std::vector<std::string> labels;  // empty: continuous
 };
 
+// A volume's value at a point (VolumeLayer::values_at).
+struct PointValue {
+  std::string volume;  // the file's name, and the field
+  std::string units;
+  double value = 0;    // NaN outside the volume
+};
+
 class VolumeLayer {
  public:
   VolumeLayer();
@@ -79,6 +86,10 @@ class VolumeLayer {
   // the whole numbers in the volume's range; else a swatch per isosurface. Empty (no colours)
   // when there is none. Throws std::invalid_argument for a malformed "transmitters" attribute.
   Legend legend() const;
+
+  // Each visible volume's value at (lat, lon) and height_agl metres above the ground there,
+  // ground_m metres above the datum (volume::PointQuery: trilinear, NaN outside), in order.
+  std::vector<PointValue> values_at(double lat, double lon, double height_agl, double ground_m) const;
 
  private:
   struct Loaded;
