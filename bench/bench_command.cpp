@@ -33,7 +33,7 @@ struct BenchOptions {
   std::vector<std::filesystem::path> dems;
   std::filesystem::path under_test;
   std::string exactness_views;
-  std::string suites = "terrain,translucency,scaling,build,exactness";
+  std::string suites = "terrain,translucency,scaling,build,exactness,rf";
   int views = 0, repeats = 0;
 };
 
@@ -85,13 +85,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build, exactness)");
+                               "' (terrain, translucency, scaling, build, exactness, rf)");
     }
     out.insert(s);
   }
@@ -206,6 +206,15 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     sizes.push_back({"generated-16", all, 16});
     results["scaling"] = scaling_suite(c, sizes);
   }
+  if (suites.count("rf")) {
+    if (std::filesystem::is_directory(data / "dem" / "utah_sdf")) {
+      volume::Transmitter t = transmitter(40.76, -111.89, 30);
+      t.frequency_mhz = 900.0;
+      results["rf"] = rf_suite(c, data / "dem" / "utah_sdf", t, o.quick ? 2 : 3);
+    } else {
+      c.log(data.string() + "/dem/utah_sdf not found: the rf suite is skipped");
+    }
+  }
   results["seconds"] = ms_since(t0) / 1000.0;
   write_report(results, o.out);
   c.log("wrote " + (o.out / "report.md").string() + " and " + (o.out / "results.json").string());
@@ -221,7 +230,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf")->capture_default_str();
   cmd->add_option("--under-test", o->under_test,
                   "The terravol executable whose render the exactness suite measures (default: this one)")
       ->check(CLI::ExistingFile);

@@ -245,6 +245,35 @@ void exactness_section(std::ostringstream& md, const json& results) {
   }
 }
 
+void rf_section(std::ostringstream& md, const json& results) {
+  if (!results.contains("rf")) return;
+  const json& r = results["rf"];
+  md << "## 8. RF volumes\n\n"
+     << "A 20 km box at 3\" with " << r["heights"].get<int>() << " receiver heights (10..310 m, "
+     << num(r["points"].get<double>() / 1e6, "%.2f") << " M points) over " << r["terrain"].get<std::string>()
+     << ", transmitter 30 m above Salt Lake City at 900 MHz: the built-in Longley-Rice ITM and Deygout models "
+        "(`compute_rf`, both cores, tiles read afresh) against SPLAT!'s own ITM (`splat -olditm`) run once per "
+        "height, as `terravol splat-volume` does (timed at "
+     << r["splat_heights"].get<int>() << " heights; its volume is its preparation plus " << r["heights"].get<int>()
+     << " times the median per height).\n\n"
+     << "| | wall s | CPU s |\n|---|---|---|\n"
+     << "| built-in ITM | " << spread(r["wall_s"]["itm"]) << " | " << spread(r["cpu_s"]["itm"]) << " |\n"
+     << "| built-in ITM, the disc only (`--disc`) | " << spread(r["wall_s"]["itm_disc"]) << " | "
+     << spread(r["cpu_s"]["itm_disc"]) << " |\n"
+     << "| built-in Deygout | " << spread(r["wall_s"]["deygout"]) << " | " << spread(r["cpu_s"]["deygout"]) << " |\n";
+  if (r.contains("splat_volume_wall_s")) {
+    md << "| SPLAT! -olditm, per height | " << spread(r["wall_s"]["splat_per_height"]) << " | "
+       << spread(r["cpu_s"]["splat_per_height"]) << " |\n"
+       << "| SPLAT! -olditm, the volume | " << num(r["splat_volume_wall_s"].get<double>()) << " | "
+       << num(r["splat_volume_cpu_s"].get<double>()) << " |\n\n"
+       << "SPLAT! / built-in ITM: " << num(r["splat_over_itm_wall"].get<double>(), "%.1f") << "x in wall time, "
+       << num(r["splat_over_itm_cpu"].get<double>(), "%.1f") << "x in CPU time; over the same disc, "
+       << num(r["splat_over_itm_disc_wall"].get<double>(), "%.1f") << "x and "
+       << num(r["splat_over_itm_disc_cpu"].get<double>(), "%.1f") << "x.\n";
+  }
+  md << "\n";
+}
+
 }  // namespace
 
 std::string headline(const json& results) {
@@ -289,6 +318,12 @@ std::string headline(const json& results) {
     for (const json& b : results["build"])
       h << "slide / build, " << b["terrain"].get<std::string>() << ": 1/"
         << num(b["build_over_slide"].get<double>(), "%.1f") << "\n";
+  if (results.contains("rf") && results["rf"].contains("splat_over_itm_wall"))
+    h << "31-height ITM volume, SPLAT! -olditm per height / built-in: "
+      << num(results["rf"]["splat_over_itm_wall"].get<double>(), "%.1f") << "x wall, "
+      << num(results["rf"]["splat_over_itm_cpu"].get<double>(), "%.1f") << "x CPU (the disc: "
+      << num(results["rf"]["splat_over_itm_disc_wall"].get<double>(), "%.1f") << "x wall, "
+      << num(results["rf"]["splat_over_itm_disc_cpu"].get<double>(), "%.1f") << "x CPU)\n";
   return h.str();
 }
 
@@ -311,6 +346,7 @@ void write_report(const json& results, const std::filesystem::path& dir) {
   scaling_section(md, results, dir);
   build_section(md, results);
   exactness_section(md, results);
+  rf_section(md, results);
   const std::string text = md.str();
   app::output::write_file_atomically(dir / "report.md", std::vector<std::uint8_t>(text.begin(), text.end()), true);
   const std::string j = results.dump(1);

@@ -15,6 +15,9 @@
 #include "bench/plain_vtk.h"
 #include "bench/stats.h"
 #include "io/mosaic.h"
+#include "volume/splat.h"
+
+#include <sys/resource.h>
 
 namespace terravol::bench {
 
@@ -482,6 +485,82 @@ json build_suite(const BenchConfig& c, const Terrain& terrain) {
   out["bytes_per_sample"] = json{{"nodes", static_cast<double>(m.nodes) / samples},
                              {"vertices", static_cast<double>(m.vertices) / samples},
                              {"total", static_cast<double>(m.total()) / samples}};
+  return out;
+}
+
+namespace {
+
+// CPU seconds of this process (all threads) or of its waited-for children.
+double cpu_seconds(int who) {
+  rusage u{};
+  getrusage(who, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+}  // namespace
+
+json rf_suite(const BenchConfig& c, const std::filesystem::path& sdf, const volume::Transmitter& tx, int splat_heights) {
+  volume::RfGrid grid;
+  grid.radius_km = 20.0;
+  grid.spacing_arcsec = 3.0;
+  for (int k = 0; k < 31; ++k) grid.heights_agl.push_back(10.0 + 10.0 * k);
+  const bool splat = std::filesystem::exists("/usr/bin/splat");
+  if (!splat) say(c, "rf: /usr/bin/splat not found: SPLAT! is not timed");
+  std::map<std::string, std::vector<double>> wall, cpu;
+  std::size_t points = 0;
+  for (int r = 0; r < c.repeats; ++r) {
+    // The box, and the disc SPLAT! computes (the same points as SPLAT!'s, RfGrid::disc).
+    for (const std::string name : {"itm", "itm_disc", "deygout"}) {
+      const double c0 = cpu_seconds(RUSAGE_SELF);
+      const auto t0 = Clock::now();
+      const io::Mosaic mosaic = io::Mosaic::open({sdf});
+      volume::RfOptions options;
+      options.model = name == "deygout" ? volume::RfModel::kDeygout : volume::RfModel::kItm;
+      volume::RfGrid run_grid = grid;
+      run_grid.disc = name == "itm_disc";
+      const volume::RfResult result = volume::compute_rf(mosaic, tx, run_grid, options);
+      wall[name].push_back(ms_since(t0) / 1000.0);
+      cpu[name].push_back(cpu_seconds(RUSAGE_SELF) - c0);
+      points = result.path_loss.values.size();
+      say(c, "rf " + name + ": " + std::to_string(wall[name].back()) + " s");
+    }
+    if (!splat) continue;
+    volume::SplatRunOptions run;
+    run.sdf_folder = sdf;
+    run.site = volume::SplatSite{"bench", tx.lat, tx.lon, tx.height_agl};
+    run.lrp.frequency_mhz = tx.frequency_mhz;
+    run.radius_km = grid.radius_km;
+    run.olditm = true;
+    run.heights_agl.assign(grid.heights_agl.begin(), grid.heights_agl.begin() + splat_heights);
+    const double c0 = cpu_seconds(RUSAGE_CHILDREN);
+    const auto t0 = Clock::now();
+    const volume::SplatRunResult result = volume::run_splat(run);
+    const double total = ms_since(t0) / 1000.0;
+    wall["splat_per_height"].push_back(result.seconds / splat_heights);
+    wall["splat_preparation"].push_back(total - result.seconds);
+    cpu["splat_per_height"].push_back((cpu_seconds(RUSAGE_CHILDREN) - c0) / splat_heights);
+    say(c, "rf splat -olditm: " + std::to_string(result.seconds / splat_heights) + " s per height");
+  }
+  json out;
+  out["terrain"] = sdf.filename().string();
+  out["tx"] = {tx.lat, tx.lon, tx.height_agl, tx.frequency_mhz};
+  out["points"] = points;
+  out["heights"] = grid.heights_agl.size();
+  out["splat_heights"] = splat ? splat_heights : 0;
+  for (const auto& [name, v] : wall) out["wall_s"][name] = to_json(summarize(v));
+  for (const auto& [name, v] : cpu) out["cpu_s"][name] = to_json(summarize(v));
+  if (splat) {
+    const double n = static_cast<double>(grid.heights_agl.size());
+    const double splat_wall = median(wall["splat_preparation"]) + n * median(wall["splat_per_height"]);
+    const double splat_cpu = n * median(cpu["splat_per_height"]);
+    out["splat_volume_wall_s"] = splat_wall;
+    out["splat_volume_cpu_s"] = splat_cpu;
+    out["splat_over_itm_wall"] = splat_wall / median(wall["itm"]);
+    out["splat_over_itm_cpu"] = splat_cpu / median(cpu["itm"]);
+    out["splat_over_itm_disc_wall"] = splat_wall / median(wall["itm_disc"]);
+    out["splat_over_itm_disc_cpu"] = splat_cpu / median(cpu["itm_disc"]);
+  }
   return out;
 }
 

@@ -78,4 +78,15 @@ bool has_exactness_scene(const std::string& terrain);
 std::vector<std::string> exactness_views(const BenchConfig& config, const std::string& terrain);
 nlohmann::json exactness_suite(const BenchConfig& config, const Terrain& terrain);
 
+// 8. RF volumes: a 20 km box at 3" with 31 receiver heights (10..310 m) over SDF tiles, the
+// built-in ITM (compute_rf, both cores, tiles read afresh) against SPLAT!'s own ITM
+// (`splat -olditm`) run once per height as `terravol splat-volume` runs it, and the built-in
+// Deygout model on the same lattice. Per repetition, one after the other: the ITM volume, the
+// Deygout volume, and SPLAT! at `splat_heights` of the heights; SPLAT!'s volume time is its
+// preparation (the tiles given to it) plus 31 times its median time per height. Wall and CPU
+// seconds (getrusage; SPLAT!'s CPU is its children's). SPLAT! is skipped without
+// /usr/bin/splat.
+nlohmann::json rf_suite(const BenchConfig& config, const std::filesystem::path& sdf_folder,
+                        const volume::Transmitter& transmitter, int splat_heights);
+
 }  // namespace terravol::bench

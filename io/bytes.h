@@ -58,4 +58,8 @@ class TextCursor {
 // Lower-case ASCII copy.
 std::string to_lower(std::string_view text);
 
+// The text with XML's five special characters as entities (&amp; &lt; &gt; &quot; &apos;), for
+// the writers' XML (KML, GDAL metadata).
+std::string xml_escaped(std::string_view text);
+
 }  // namespace terravol::io

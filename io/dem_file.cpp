@@ -1,5 +1,6 @@
 #include "io/dem_file.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <system_error>
@@ -40,27 +41,86 @@ std::string read_text_if_exists(const std::filesystem::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+constexpr Format kFormats[] = {Format::kSrtm,     Format::kDted,    Format::kUsgsDem,
+                               Format::kEsriAscii, Format::kGeoTiff, Format::kSdf};
+
+// decompress_content; *zip_entry (when given) gets the name of the entry a .zip gave.
+std::vector<std::uint8_t> unpack(Bytes file_bytes, const std::string& source, std::string_view file_name,
+                                 std::string* zip_entry) {
+  const Compression compression = compression_from_name(file_name);
+  check_magic(compression, file_bytes, source);
+  switch (compression) {
+    case Compression::kNone: return {file_bytes.begin(), file_bytes.end()};
+    case Compression::kGzip: return gunzip(file_bytes, source);
+    case Compression::kBzip2: return bunzip2(file_bytes, source);
+    case Compression::kXz: return unxz(file_bytes, source);
+    case Compression::kZip: break;
+  }
+  std::vector<std::string_view> suffixes;
+  if (const auto format = format_from_name(std::string(file_name))) {
+    const auto ext = format_extensions(*format);
+    suffixes.assign(ext.begin(), ext.end());
+  } else {
+    for (const Format f : kFormats) {
+      const auto ext = format_extensions(f);
+      suffixes.insert(suffixes.end(), ext.begin(), ext.end());
+    }
+  }
+  ZipEntry entry = unzip_entry(file_bytes, source, suffixes);
+  if (zip_entry != nullptr) *zip_entry = entry.name;
+  return std::move(entry.bytes);
+}
+
+// The message of a parser's error on content that is compressed although the name said it
+// was not: the parser's complaint, and what the content is.
+std::string misnamed(const FormatError& e, Compression found, const std::string& file_name) {
+  const std::string what = e.what();
+  const std::string problem = what.substr(std::min(what.size(), e.source().size() + 2));
+  return problem + " (the file holds " + std::string(compression_label(found)) + " data: name it " + file_name +
+         std::string(compression_extension(found)) + ")";
+}
+
 }  // namespace
 
+std::span<const std::string_view> format_extensions(Format format) {
+  static constexpr std::string_view kSrtm[] = {".hgt"};
+  static constexpr std::string_view kDted[] = {".dt0", ".dt1", ".dt2"};
+  static constexpr std::string_view kUsgs[] = {".dem"};
+  static constexpr std::string_view kAsc[] = {".asc"};
+  static constexpr std::string_view kTiff[] = {".tif", ".tiff"};
+  static constexpr std::string_view kSdf[] = {".sdf"};
+  switch (format) {
+    case Format::kSrtm: return kSrtm;
+    case Format::kDted: return kDted;
+    case Format::kUsgsDem: return kUsgs;
+    case Format::kEsriAscii: return kAsc;
+    case Format::kGeoTiff: return kTiff;
+    case Format::kSdf: return kSdf;
+  }
+  return {};
+}
+
 std::optional<Format> format_from_name(const std::filesystem::path& path) {
-  const std::string name = to_lower(path.filename().string());
-  if (ends_with(name, ".hgt") || ends_with(name, ".hgt.gz") || ends_with(name, ".hgt.zip")) return Format::kSrtm;
-  if (ends_with(name, ".dt0") || ends_with(name, ".dt1") || ends_with(name, ".dt2")) return Format::kDted;
-  if (ends_with(name, ".dem")) return Format::kUsgsDem;
-  if (ends_with(name, ".asc")) return Format::kEsriAscii;
-  if (ends_with(name, ".tif") || ends_with(name, ".tiff")) return Format::kGeoTiff;
-  if (ends_with(name, ".sdf") || ends_with(name, ".sdf.bz2")) return Format::kSdf;
+  const std::string name = to_lower(strip_compression(path.filename().string()));
+  for (const Format f : kFormats) {
+    for (const std::string_view ext : format_extensions(f)) {
+      if (ends_with(name, ext)) return f;
+    }
+  }
   return std::nullopt;
+}
+
+std::vector<std::uint8_t> decompress_content(Bytes file_bytes, const std::string& source,
+                                             std::string_view file_name) {
+  return unpack(file_bytes, source, file_name, nullptr);
 }
 
 std::vector<std::uint8_t> read_content(const std::filesystem::path& path) {
   const std::string source = path.string();
   std::vector<std::uint8_t> bytes = read_bytes(path, source);
-  const std::string name = to_lower(path.filename().string());
-  if (ends_with(name, ".gz")) return gunzip(bytes, source);
-  if (ends_with(name, ".bz2")) return bunzip2(bytes, source);
-  if (ends_with(name, ".zip")) return unzip_entry(bytes, source, ".hgt");
-  return bytes;
+  const std::string name = path.filename().string();
+  if (compression_from_name(name) == Compression::kNone) return bytes;
+  return unpack(bytes, source, name, nullptr);
 }
 
 Grid parse_dem(Format format, Bytes content, const std::string& source, std::string_view file_name,
@@ -85,18 +145,39 @@ Grid parse_dem(Format format, Bytes content, const std::string& source, std::str
 
 Grid read_dem(const std::filesystem::path& path, const ReadOptions& options) {
   const std::string source = path.string();
+  const std::string name = path.filename().string();
   const auto format = format_from_name(path);
   if (!format) {
-    throw FormatError(source, "unknown DEM format (expected .hgt[.gz|.zip], .dt0/1/2, .dem, .asc, .tif, .sdf[.bz2])");
+    throw FormatError(source,
+                      "unknown DEM format (expected .hgt, .dt0/1/2, .dem, .asc, .tif, .sdf, each also "
+                      "compressed as .gz, .bz2, .xz or .zip)");
   }
-  const std::vector<std::uint8_t> content = read_content(path);
+  const std::vector<std::uint8_t> bytes = read_bytes(path, source);
+  const Compression compression = compression_from_name(name);
+  std::string entry;
+  std::vector<std::uint8_t> unpacked;
+  if (compression != Compression::kNone) unpacked = unpack(bytes, source, name, &entry);
+  const Bytes content = compression != Compression::kNone ? Bytes(unpacked) : Bytes(bytes);
   std::string prj;
   if (*format == Format::kEsriAscii) {
-    std::filesystem::path prj_path = path;
-    prj_path.replace_extension(".prj");
-    prj = read_text_if_exists(prj_path);
+    std::optional<std::vector<std::uint8_t>> in_zip;
+    if (!entry.empty()) {
+      in_zip = unzip_named(bytes, source, std::filesystem::path(entry).replace_extension(".prj").string(), 1u << 20);
+    }
+    if (in_zip) {
+      prj.assign(in_zip->begin(), in_zip->end());
+    } else {
+      std::filesystem::path prj_path = path.parent_path() / std::string(strip_compression(name));
+      prj = read_text_if_exists(prj_path.replace_extension(".prj"));
+    }
   }
-  return parse_dem(*format, content, source, path.filename().string(), options, prj);
+  try {
+    return parse_dem(*format, content, source, name, options, prj);
+  } catch (const FormatError& e) {
+    const Compression found = compression_from_magic(content);
+    if (compression != Compression::kNone || found == Compression::kNone) throw;
+    throw FormatError(source, misnamed(e, found, name));
+  }
 }
 
 }  // namespace terravol::io

@@ -13,11 +13,9 @@
 #include <geotiff.h>
 #include <geovalues.h>
 #include <tiffio.h>
-#include <xtiffio.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -28,6 +26,7 @@
 
 #include "io/error.h"
 #include "io/readers.h"
+#include "io/tiff_memory.h"
 
 namespace terravol::io {
 
@@ -49,138 +48,6 @@ constexpr tmsize_t kMaxLibtiffAlloc = tmsize_t{256} << 20;
 // Largest tile decoded at once (strips are decoded a row at a time). With the largest grid
 // (kMaxSamples floats and mask bytes) this keeps a hostile header under 1.5 GiB.
 constexpr std::uint64_t kMaxTileBytes = std::uint64_t{256} << 20;
-
-// ---- libtiff over a byte span --------------------------------------------------------------
-
-struct MemoryFile {
-  const std::uint8_t* data = nullptr;
-  std::uint64_t size = 0;
-  std::uint64_t pos = 0;
-};
-
-tmsize_t mem_read(thandle_t h, void* buf, tmsize_t n) {
-  auto* f = static_cast<MemoryFile*>(h);
-  if (n <= 0 || f->pos >= f->size) return 0;
-  const std::uint64_t count =
-      std::min<std::uint64_t>(static_cast<std::uint64_t>(n), f->size - f->pos);
-  std::memcpy(buf, f->data + f->pos, static_cast<std::size_t>(count));
-  f->pos += count;
-  return static_cast<tmsize_t>(count);
-}
-
-tmsize_t mem_write(thandle_t, void*, tmsize_t) {
-  return 0;
-}
-
-toff_t mem_seek(thandle_t h, toff_t off, int whence) {
-  auto* f = static_cast<MemoryFile*>(h);
-  std::uint64_t base = 0;
-  switch (whence) {
-    case SEEK_SET:
-      f->pos = off;
-      return f->pos;
-    case SEEK_CUR:
-      base = f->pos;
-      break;
-    case SEEK_END:
-      base = f->size;
-      break;
-    default:
-      return static_cast<toff_t>(-1);
-  }
-  // libtiff passes negative relative offsets as two's complement.
-  if (static_cast<std::int64_t>(off) < 0) {
-    const std::uint64_t back = std::uint64_t{0} - off;
-    if (back > base) return static_cast<toff_t>(-1);
-    f->pos = base - back;
-  } else {
-    if (off > std::numeric_limits<std::uint64_t>::max() - base) return static_cast<toff_t>(-1);
-    f->pos = base + off;
-  }
-  return f->pos;
-}
-
-int mem_close(thandle_t) {
-  return 0;
-}
-toff_t mem_size(thandle_t h) {
-  return static_cast<MemoryFile*>(h)->size;
-}
-
-int mem_map(thandle_t h, void** base, toff_t* size) {
-  auto* f = static_cast<MemoryFile*>(h);
-  // Opened read-only: libtiff never writes through the mapping.
-  *base = const_cast<std::uint8_t*>(f->data);
-  *size = f->size;
-  return 1;
-}
-
-void mem_unmap(thandle_t, void*, toff_t) {}
-
-// The last libtiff/libgeotiff error, kept for the FormatError; nothing is printed.
-struct Diagnostics {
-  std::string last_error;
-};
-
-void record(Diagnostics* d, const char* module, const char* fmt, va_list ap) {
-  char buf[512];
-  std::vsnprintf(buf, sizeof buf, fmt, ap);
-  std::string text = (module && *module) ? std::string(module) + ": " + buf : std::string(buf);
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  d->last_error = std::move(text);
-}
-
-int on_tiff_error(TIFF*, void* user, const char* module, const char* fmt, va_list ap) {
-  record(static_cast<Diagnostics*>(user), module, fmt, ap);
-  return 1;  // handled: libtiff's global handler (stderr) is not called
-}
-
-int on_tiff_warning(TIFF*, void*, const char*, const char*, va_list) {
-  return 1;
-}
-
-void on_geotiff_message(GTIF* gt, int level, const char* fmt, ...) {
-  if (level != LIBGEOTIFF_ERROR || gt == nullptr) return;
-  auto* d = static_cast<Diagnostics*>(GTIFGetUserData(gt));
-  if (d == nullptr) return;
-  va_list ap;
-  va_start(ap, fmt);
-  record(d, "libgeotiff", fmt, ap);
-  va_end(ap);
-}
-
-// GDAL_NODATA is not in libtiff 4.5's tag table; without this it would be read as an
-// anonymous tag. Chained after libgeotiff's extender, which registers the GeoTIFF tags.
-TIFFExtendProc g_parent_extender = nullptr;
-
-void extend_tags(TIFF* tif) {
-  static const TIFFFieldInfo kFields[] = {{TIFFTAG_GDAL_NODATA, TIFF_VARIABLE, TIFF_VARIABLE,
-                                           TIFF_ASCII, FIELD_CUSTOM, 1, 0,
-                                           const_cast<char*>("GDALNoDataValue")}};
-  TIFFMergeFieldInfo(tif, kFields, 1);
-  if (g_parent_extender) g_parent_extender(tif);
-}
-
-void register_tags_once() {
-  static const bool done = [] {
-    XTIFFInitialize();
-    g_parent_extender = TIFFSetTagExtender(extend_tags);
-    return true;
-  }();
-  (void)done;
-}
-
-struct TiffCloser {
-  void operator()(TIFF* t) const { TIFFClose(t); }
-};
-struct GtifFreer {
-  void operator()(GTIF* g) const { GTIFFree(g); }
-};
-struct OptionsFreer {
-  void operator()(TIFFOpenOptions* o) const { TIFFOpenOptionsFree(o); }
-};
 
 // ---- tags and keys -------------------------------------------------------------------------
 
@@ -631,22 +498,14 @@ Grid parse_geotiff(Bytes data, const std::string& source) {
         (data[0] == 'M' && data[1] == 'M' && data[2] == 0 && (data[3] == 42 || data[3] == 43)))) {
     throw FormatError(source, "not a TIFF file (no II*/MM* header)");
   }
-  register_tags_once();
-  Diagnostics diag;
+  tiff::Diagnostics diag;
   const auto with_libtiff = [&](std::string what) {
     if (!diag.last_error.empty()) what += " (" + diag.last_error + ")";
     return FormatError(source, what);
   };
 
-  std::unique_ptr<TIFFOpenOptions, OptionsFreer> options(TIFFOpenOptionsAlloc());
-  if (!options) throw FormatError(source, "out of memory opening the TIFF");
-  TIFFOpenOptionsSetErrorHandlerExtR(options.get(), on_tiff_error, &diag);
-  TIFFOpenOptionsSetWarningHandlerExtR(options.get(), on_tiff_warning, nullptr);
-  TIFFOpenOptionsSetMaxSingleMemAlloc(options.get(), kMaxLibtiffAlloc);
-  MemoryFile file{data.data(), data.size(), 0};
-  std::unique_ptr<TIFF, TiffCloser> tif(TIFFClientOpenExt(source.c_str(), "r", &file, mem_read,
-                                                          mem_write, mem_seek, mem_close, mem_size,
-                                                          mem_map, mem_unmap, options.get()));
+  tiff::MemoryFile file{data};
+  const tiff::TiffPtr tif = tiff::open(file, "r", source, diag, kMaxLibtiffAlloc);
   if (!tif) throw with_libtiff("cannot read the TIFF header and first directory");
   TIFF* t = tif.get();
 
@@ -754,7 +613,7 @@ Grid parse_geotiff(Bytes data, const std::string& source) {
   }
 
   // Georeference, CRS and heights' meaning.
-  std::unique_ptr<GTIF, GtifFreer> gt(GTIFNewEx(t, on_geotiff_message, &diag));
+  const tiff::GtifPtr gt = tiff::open_keys(t, diag);
   if (!gt) throw with_libtiff("GeoKeyDirectoryTag is malformed");
   int key_count = 0;
   GTIFDirectoryInfo(gt.get(), nullptr, &key_count);

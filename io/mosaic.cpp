@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <system_error>
 
+#include "io/compressed.h"
 #include "io/error.h"
 #include "io/geographic.h"
 #include "io/sdf_name.h"
@@ -16,16 +16,6 @@ namespace {
 
 bool name_has(const std::filesystem::path& p, std::string_view what) {
   return to_lower(p.filename().string()).find(what) != std::string::npos;
-}
-
-// The last four bytes of a gzip stream: the uncompressed size modulo 2^32 (RFC 1952, 2.3.1).
-std::optional<std::uint32_t> gzip_size(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in || in.tellg() < 18) return std::nullopt;
-  in.seekg(-4, std::ios::end);
-  unsigned char b[4];
-  if (!in.read(reinterpret_cast<char*>(b), 4)) return std::nullopt;
-  return static_cast<std::uint32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint32_t>(b[3]) << 24));
 }
 
 // Extent from the file name (and size) alone, for SRTM and SDF tiles; nullopt when the name
@@ -40,16 +30,15 @@ std::optional<MosaicTile> tile_from_name(const std::filesystem::path& path, Form
     const auto corner = srtm_corner_from_name(name);
     if (!corner) return std::nullopt;
     std::uintmax_t bytes = 0;
-    std::error_code ec;
-    if (name_has(path, ".gz")) {
-      const auto s = gzip_size(path);
-      if (!s) return std::nullopt;
-      bytes = *s;
-    } else if (name_has(path, ".zip")) {
-      return std::nullopt;
-    } else {
+    const Compression compression = compression_from_name(name);
+    if (compression == Compression::kNone) {
+      std::error_code ec;
       bytes = std::filesystem::file_size(path, ec);
       if (ec) return std::nullopt;
+    } else {
+      const auto recorded = recorded_size(path, compression, format_extensions(Format::kSrtm));
+      if (!recorded) return std::nullopt;  // bzip2: read at open
+      bytes = *recorded;
     }
     int n = 0;
     if (bytes == 1201u * 1201u * 2u) n = 1201;

@@ -35,15 +35,16 @@ struct MosaicGap {
 // Where tiles overlap (SRTM and DTED neighbours share their edge samples) the first tile in
 // input order provides the sample; the others' copies are not read.
 //
-// Laziness: open() learns each tile's extent from its name (SRTM N44W072, SDF 40_41_111_112)
-// and, for .hgt, its size on disk, without reading it; other tiles are read once at open() to
-// learn their extent and kept in the cache. Decoded tiles live in a cache of at most
+// Laziness: open() learns each tile's extent from its name (SRTM N44W072, SDF 40_41_111_112,
+// compressed or not) and, for .hgt, its size on disk or the size a .hgt.gz, .hgt.xz or
+// .hgt.zip records (compressed.h, recorded_size), without reading it; other tiles (.hgt.bz2:
+// bzip2 records no size) are read once at open() to learn their extent and kept in the cache. Decoded tiles live in a cache of at most
 // `cache_tiles` tiles, so memory is bounded by the window and the cache, not by the number
 // of input files. Not thread-safe (the cache is shared).
 class Mosaic {
  public:
   // inputs: files and directories (a directory contributes every file in it whose name has a
-  // DEM extension, in name order). Throws FormatError for an unreadable input, an empty
+  // DEM extension, compressed or not (format_from_name), in name order). Throws FormatError for an unreadable input, an empty
   // directory, an unknown format, tiles of different spacing or off the lattice.
   static Mosaic open(const std::vector<std::filesystem::path>& inputs, const ReadOptions& options = {},
                      std::size_t cache_tiles = 4);

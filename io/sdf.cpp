@@ -8,6 +8,7 @@
 // Hand-written: no library Terravol may use reads SDF (GDAL does not either).
 #include <string>
 
+#include "io/compressed.h"
 #include "io/error.h"
 #include "io/readers.h"
 #include "io/sdf_name.h"
@@ -83,11 +84,12 @@ std::optional<TileCorner> sdf_corner_from_name(std::string_view name) {
   const std::size_t slash = name.find_last_of("/\\");
   if (slash != std::string_view::npos) name.remove_prefix(slash + 1);
   const std::string lower = to_lower(name);
-  std::string_view s = lower;
-  for (const std::string_view suffix : {".bz2", ".sdf", "-hd"}) {
+  std::string_view s = strip_compression(lower);
+  if (s.size() != lower.size() && !ends_with(s, ".sdf")) return std::nullopt;  // "x.gz" is no SDF
+  for (const std::string_view suffix : {".sdf", "-hd"}) {
     if (ends_with(s, suffix)) s.remove_suffix(suffix.size());
   }
-  if (s.empty() || ends_with(lower, ".bz2") != ends_with(lower, ".sdf.bz2")) return std::nullopt;
+  if (s.empty()) return std::nullopt;
   int v[4];
   char separator = 0;
   for (int i = 0; i < 4; ++i) {

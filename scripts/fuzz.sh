@@ -25,7 +25,11 @@ for t in "${targets[@]}"; do
       esri_ascii) head -c 65536 "$data/front_range_srtmgl3.asc" > "$corpus/seed" ;;
       geotiff) cp "$data/olinda_dem_utm25s.tif" "$corpus/seed" ;;
       sdf) (bzcat "$data/utah_sdf/40_41_111_112.sdf.bz2" || true) | head -c 65536 > "$corpus/seed" ;;  # bzcat ends on SIGPIPE
-      decompress) head -c 65536 "$data/S46W066.hgt.gz" > "$corpus/seed.gz"; head -c 65536 "$data/utah_sdf/40_41_111_112.sdf.bz2" > "$corpus/seed.bz2" ;;
+      decompress) head -c 65536 "$data/S46W066.hgt.gz" > "$corpus/seed.gz"; head -c 65536 "$data/utah_sdf/40_41_111_112.sdf.bz2" > "$corpus/seed.bz2"
+        head -c 30000 "$data/N44W072.hgt" > "$corpus/N44W072.hgt"
+        if command -v xz >/dev/null; then xz -0 -c "$corpus/N44W072.hgt" > "$corpus/seed.xz"; fi
+        if command -v zip >/dev/null; then (cd "$corpus" && zip -q seed.zip N44W072.hgt); fi
+        rm "$corpus/N44W072.hgt" ;;
     esac
   fi
   echo "== fuzz_$t for ${seconds}s" >&2

@@ -19,11 +19,12 @@ using Rgb8 = std::array<std::uint8_t, 3>;
 
 struct Image {
   int width = 0, height = 0;
-  std::vector<Rgb8> pixels;  // row 0 at the TOP of the image, as it is seen
+  std::vector<Rgb8> pixels;         // row 0 at the TOP of the image, as it is seen
+  std::vector<std::uint8_t> alpha;  // the same order; 255 where the PNG has no alpha
   const Rgb8& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
-// The output of a PNG reader as RGB, row 0 at the top (alpha dropped; grey expanded).
+// The output of a PNG reader as RGB and alpha, row 0 at the top (grey expanded).
 inline Image image_of(vtkPNGReader* reader) {
   Image img;
   reader->Update();
@@ -35,6 +36,7 @@ inline Image image_of(vtkPNGReader* reader) {
   img.width = dims[0];
   img.height = dims[1];
   img.pixels.resize(static_cast<std::size_t>(img.width) * img.height);
+  img.alpha.assign(img.pixels.size(), 255);
   const int comps = scalars->GetNumberOfComponents();
   for (int y = 0; y < img.height; ++y) {
     for (int x = 0; x < img.width; ++x) {
@@ -42,6 +44,10 @@ inline Image image_of(vtkPNGReader* reader) {
       Rgb8& p = img.pixels[static_cast<std::size_t>(img.height - 1 - y) * img.width + x];
       for (int k = 0; k < 3; ++k) {
         p[k] = static_cast<std::uint8_t>(scalars->GetComponent(id, comps >= 3 ? k : 0));
+      }
+      if (comps == 2 || comps == 4) {
+        img.alpha[static_cast<std::size_t>(img.height - 1 - y) * img.width + x] =
+            static_cast<std::uint8_t>(scalars->GetComponent(id, comps - 1));
       }
     }
   }

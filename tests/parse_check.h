@@ -28,6 +28,17 @@ void expect_grid_or_one_line_error(Parse parse, const std::string& source, const
   }
 }
 
+// The message of the io::FormatError that f() throws, "" when it throws none.
+template <class F>
+std::string format_error_of(F f) {
+  try {
+    f();
+  } catch (const io::FormatError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // Every prefix of `text` (lengths 0, step, 2 step, ...) parsed by parse(prefix).
 template <class Parse>
 void expect_prefixes_handled(Parse parse, const std::string& text, std::size_t step, const std::string& source) {

@@ -41,7 +41,9 @@ double median(std::vector<double>& v) {
   return 0.5 * (lower + upper);
 }
 
-LayerComparison summarise(const std::vector<double>& a, const std::vector<double>& b, double w2) {
+}  // namespace
+
+LayerComparison compare_values(std::span<const double> a, std::span<const double> b, double w2) {
   LayerComparison r;
   r.w2 = w2;
   r.points = a.size();
@@ -60,7 +62,7 @@ LayerComparison summarise(const std::vector<double>& a, const std::vector<double
     sab += (a[k] - ma) * (b[k] - mb);
   }
   r.pearson = (a.size() >= 2 && saa > 0.0 && sbb > 0.0) ? sab / std::sqrt(saa * sbb) : kNaN;
-  std::vector<double> d(a.size()), ad(a.size()), ca = a, cb = b;
+  std::vector<double> d(a.size()), ad(a.size()), ca(a.begin(), a.end()), cb(b.begin(), b.end());
   for (std::size_t k = 0; k < a.size(); ++k) {
     d[k] = b[k] - a[k];
     ad[k] = std::abs(d[k]);
@@ -71,8 +73,6 @@ LayerComparison summarise(const std::vector<double>& a, const std::vector<double
   r.median_b = median(cb);
   return r;
 }
-
-}  // namespace
 
 std::optional<double> sample_trilinear(const Volume& v, double w0, double w1, double w2) {
   const Lattice& l = v.lattice;
@@ -121,11 +121,11 @@ Comparison compare_volumes(const Volume& a, const Volume& b) {
         vb.push_back(*y);
       }
     }
-    out.layers.push_back(summarise(va, vb, w2));
+    out.layers.push_back(compare_values(va, vb, w2));
     all_a.insert(all_a.end(), va.begin(), va.end());
     all_b.insert(all_b.end(), vb.begin(), vb.end());
   }
-  out.all = summarise(all_a, all_b, kNaN);
+  out.all = compare_values(all_a, all_b, kNaN);
   return out;
 }
 

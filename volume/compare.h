@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "volume/volume.h"
@@ -34,6 +35,10 @@ struct Comparison {
   std::vector<LayerComparison> layers;  // one per layer of A, bottom up
   LayerComparison all;                  // every layer together (w2 = NaN)
 };
+
+// The figures of LayerComparison for paired values a[k], b[k] (same size), at layer w2.
+// Medians of an even count are the mean of the two middle values.
+LayerComparison compare_values(std::span<const double> a, std::span<const double> b, double w2);
 
 // Resamples B at every lattice point of A (sample_trilinear) and compares, per layer of A.
 // Medians of an even count are the mean of the two middle values.

@@ -25,9 +25,14 @@ glm::u8vec4 IsoSpec::rgba() const {
 }
 
 glm::u8vec3 default_isosurface_color(std::size_t index) {
-  // M. Okabe and K. Ito, "Color Universal Design" (2008), without its black.
-  static constexpr std::array<glm::u8vec3, 7> kPalette{{
-      {230, 159, 0}, {86, 180, 233}, {0, 158, 115}, {240, 228, 66}, {0, 114, 178}, {213, 94, 0}, {204, 121, 167},
+  // Chosen by a greedy search over the sRGB cube (steps of 15): each colour as far (CIE76
+  // Delta E*ab) from every colour of every slice map as possible, and from the colours before
+  // it, with lightness L* >= 50 and at least 30 from the terrain atlas (app/scene/terrain_colors.cpp)
+  // so that it reads over the ground. Nearest slice map colours: plasma (42.7, 35.8), turbo
+  // (32.9, 26.6, 26.3). The maps cover most of the cube (turbo, jet and grey alone span every
+  // hue and every grey), which is why these are magentas, pinks, a bronze and greens.
+  static constexpr std::array<glm::u8vec3, 5> kPalette{{
+      {255, 0, 255}, {255, 165, 225}, {150, 120, 15}, {180, 255, 210}, {0, 255, 0},
   }};
   return kPalette[index % kPalette.size()];
 }

@@ -46,7 +46,7 @@ Mesh decimate(const Mesh& mesh, std::size_t max_triangles);
 // One isosurface level as given on a command line or in a scene file.
 struct IsoSpec {
   float value = 0.0f;               // in the volume's units (dB, dBm, ...)
-  glm::u8vec3 color{255, 200, 0};   // sRGB
+  glm::u8vec3 color{255, 0, 255};   // sRGB; default_isosurface_color(0)
   double opacity = 0.5;             // [0, 1]
 
   glm::u8vec4 rgba() const;  // alpha = round(opacity * 255)
@@ -67,9 +67,10 @@ struct IsoSpec {
 // Throws std::invalid_argument when `value` is not finite.
 Mesh isosurface(const Volume& volume, const LatticeMapper& mapper, float value, glm::u8vec4 rgba);
 
-// The default colour of the index-th isosurface when none is given: the Okabe-Ito colour-blind
-// safe palette (orange, sky blue, bluish green, yellow, blue, vermillion, reddish purple),
-// cycled.
+// The default colour of the index-th isosurface when none is given, cycling through five
+// colours (magenta, pink, bronze, mint, green) that no slice colour map uses: each is at least
+// 25 CIE76 Delta E*ab from every colour of every map of volume/colormap.h, and 60 from the
+// others, so a surface never reads as part of a slice, whichever map the slice uses.
 glm::u8vec3 default_isosurface_color(std::size_t index);
 
 // Parses "VALUE[,color=R:G:B|#RRGGBB][,opacity=A]", e.g. "120" or "120,color=255:200:0,opacity=0.4".

@@ -33,7 +33,7 @@ RfPlan plan_rf(const DemExtent& dem, double dem_spacing_arcsec, std::vector<Tran
             const RfGrid& grid_in, const RfOptions& options) {
   if (transmitters.empty()) throw std::invalid_argument("no transmitter");
   RfPlan plan;
-  plan.grid = resolve_grid(grid_in, dem_spacing_arcsec);
+  plan.grid = resolve_grid(grid_in, dem_spacing_arcsec, options.model);
   plan.transmitters = std::move(transmitters);
   const Transmitter& anchor = plan.transmitters.front();
   const double s = plan.grid.spacing_arcsec / 3600.0;
@@ -127,7 +127,9 @@ std::vector<float> compute_share(const io::Grid& dem, const RfPlan& plan, const 
       };
     }
     const RfStats st = compute_rf_rows(dem, plan.transmitters[t], b, share.rows[t], o,
-                                       std::span<float>(out).subspan(offset, n));
+                                       std::span<float>(out).subspan(offset, n),
+                                       plan.grid.disc ? plan.grid.radius_km : 0.0);
+    sum.itm_warned += st.itm_warned;
     sum.columns += st.columns;
     sum.samples += st.samples;
     sum.seconds += st.seconds;
@@ -141,6 +143,7 @@ PlanAssembler::PlanAssembler(const RfPlan& plan, const RfOptions& options, const
     : plan_(plan) {
   for (std::size_t t = 0; t < plan.boxes.size(); ++t) {
     volumes_.push_back(path_loss_volume(plan.transmitters[t], plan.boxes[t], options, vertical_datum));
+    if (plan.grid.disc) volumes_.back().attributes["disc_radius_km"] = num(plan.grid.radius_km);
     filled_.emplace_back(static_cast<std::size_t>(plan.boxes[t].dims[1]), 0);
     missing_ += static_cast<std::size_t>(plan.boxes[t].dims[1]);
   }

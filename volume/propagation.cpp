@@ -50,6 +50,13 @@
 //    horizontal of the k-factor Earth). SPLAT! (PlotLRPath) instead takes the line to the first
 //    terrain sample above the line of sight; on a diffracted path the two differ by up to the
 //    angle between the first obstruction and the highest edge.
+//
+// With RfModel::kItm the same profile goes to the Longley-Rice model instead (volume/itm.h,
+// whose effective Earth comes from the surface refractivity): the profile without the bulge,
+// the antennas' heights above the ground at its ends, basic transmission loss out. The antenna
+// pattern applies to it the same way (ColumnModel): ITM finds no knife edges, so its departure is
+// the steepest line from the transmitter over the whole profile (k-factor Earth), the horizon
+// ray of an obstructed path, the direct line of a clear one.
 #include "volume/propagation.h"
 
 #include <GeographicLib/Geodesic.hpp>
@@ -63,6 +70,7 @@
 #include <cstdio>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "io/scene_frame.h"
@@ -128,13 +136,17 @@ double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool
 
 double wavelength(double frequency_mhz) { return kSpeedOfLight / (frequency_mhz * 1e6); }
 
-// Bilinear height of a geographic grid at (lat, lon), clamped to its edges.
+// Bilinear height of a geographic grid at (lat, lon), clamped to its edges; at() takes the
+// position in the grid's (fractional) column and row instead.
 class DemSampler {
  public:
   explicit DemSampler(const io::Grid& g) : g_(g) {}
-  double operator()(double lat, double lon) const {
-    const double c = std::clamp((lon - g_.georef.x0) / g_.georef.dx, 0.0, static_cast<double>(g_.cols - 1));
-    const double r = std::clamp((g_.georef.y0 - lat) / g_.georef.dy, 0.0, static_cast<double>(g_.rows - 1));
+  double column(double lon) const { return (lon - g_.georef.x0) / g_.georef.dx; }
+  double row(double lat) const { return (g_.georef.y0 - lat) / g_.georef.dy; }
+  double operator()(double lat, double lon) const { return at(column(lon), row(lat)); }
+  double at(double column, double row) const {
+    const double c = std::clamp(column, 0.0, static_cast<double>(g_.cols - 1));
+    const double r = std::clamp(row, 0.0, static_cast<double>(g_.rows - 1));
     const int c0 = std::min(static_cast<int>(c), g_.cols - 2), r0 = std::min(static_cast<int>(r), g_.rows - 2);
     const double fc = c - c0, fr = r - r0;
     const float* row0 = &g_.heights[g_.index(r0, c0)];
@@ -148,10 +160,15 @@ class DemSampler {
   const io::Grid& g_;
 };
 
-}  // namespace
+constexpr double kItmMinHeight = 0.5, kItmMaxHeight = 3000.0;  // the Algorithm's antenna limits
+// ITM has no value at zero distance; a lattice column placed on another transmitter's grid can
+// land within rounding (nanometres) of its own transmitter, so "no path" is under a metre.
+constexpr double kItmMinDistance = 1.0;
 
-void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
-  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+void bad(const std::string& what) { throw std::invalid_argument(what); }
+
+// The transmitter and the model's options.
+void check_model(const Transmitter& tx, const RfOptions& options) {
   if (!std::isfinite(tx.lat) || std::abs(tx.lat) > 85.0) bad("transmitter latitude " + num(tx.lat) + ": must be within [-85, 85]");
   if (!std::isfinite(tx.lon) || std::abs(tx.lon) > 360.0) bad("transmitter longitude " + num(tx.lon) + ": must be within [-360, 360]");
   if (!std::isfinite(tx.height_agl) || tx.height_agl < 0.0 || tx.height_agl > 100000.0) {
@@ -163,6 +180,18 @@ void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOpti
   if (tx.erp_w && (!std::isfinite(*tx.erp_w) || *tx.erp_w <= 0.0 || *tx.erp_w > 1e9)) {
     bad("ERP " + num(*tx.erp_w) + ": must be within (0, 1e9] W");
   }
+  if (!std::isfinite(options.k_factor) || options.k_factor <= 0.0) bad("k-factor " + num(options.k_factor) + ": must be > 0");
+  if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
+  if (options.model == RfModel::kItm) {
+    check_itm(tx.frequency_mhz, options.itm);
+    if (tx.height_agl < kItmMinHeight || tx.height_agl > kItmMaxHeight) {
+      bad("transmitter height " + num(tx.height_agl) + ": ITM takes antenna heights within [0.5, 3000] m above ground");
+    }
+  }
+}
+
+// The receiver lattice, for that model.
+void check_grid(const RfGrid& grid, const RfOptions& options) {
   if (!std::isfinite(grid.radius_km) || grid.radius_km <= 0.0 || grid.radius_km > 500.0) {
     bad("radius " + num(grid.radius_km) + ": must be within (0, 500] km");
   }
@@ -172,14 +201,20 @@ void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOpti
   const auto& h = grid.heights_agl;
   for (std::size_t n = 0; n < h.size(); ++n) {
     if (!std::isfinite(h[n]) || h[n] < 0.0 || h[n] > 100000.0) bad("height " + num(h[n]) + ": must be within [0, 100000] m");
+    if (options.model == RfModel::kItm && (h[n] < kItmMinHeight || h[n] > kItmMaxHeight)) {
+      bad("height " + num(h[n]) + ": ITM takes antenna heights within [0.5, 3000] m above ground");
+    }
     if (n > 0 && h[n] <= h[n - 1]) bad("heights must increase");
     if (n > 1 && std::abs((h[n] - h[n - 1]) - (h[1] - h[0])) > 1e-6) bad("heights must be evenly spaced");
   }
-  if (!std::isfinite(options.k_factor) || options.k_factor <= 0.0) bad("k-factor " + num(options.k_factor) + ": must be > 0");
-  if (options.edge_depth < 1 || options.edge_depth > 16) bad("edge depth " + std::to_string(options.edge_depth) + ": must be within [1, 16]");
 }
 
-namespace {
+std::vector<double> default_heights(RfModel model) {
+  const double first = model == RfModel::kItm ? 10.0 : 0.0;
+  std::vector<double> h;
+  for (int n = 0; n <= 40; ++n) h.push_back(first + 50.0 * n);
+  return h;
+}
 
 void check_dem(const io::Grid& dem) {
   if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
@@ -194,93 +229,19 @@ void check_inside(const DemExtent& e, double lat, double lon, const std::string&
   }
 }
 
-std::vector<double> default_heights() {
-  std::vector<double> h;
-  for (int n = 0; n <= 40; ++n) h.push_back(50.0 * n);
-  return h;
+// The profile step compute_rf uses for tx over this DEM: its finer spacing in metres at the
+// transmitter.
+double profile_step_m(const io::Grid& dem, const Transmitter& tx) {
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  return std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
 }
 
-// The model's geometry for one transmitter: every path is built and evaluated here, for
-// compute_rf_rows and rf_path alike.
-class PathModel {
- public:
-  PathModel(const io::Grid& dem, const Transmitter& tx, const RfOptions& options)
-      : tx_(tx), options_(options), ground_(dem), geod_(GeographicLib::Geodesic::WGS84()) {
-    const io::SceneFrame frame(tx.lat, tx.lon);
-    step_m_ = std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
-    lambda_ = wavelength(tx.frequency_mhz);
-    two_ka_ = 2.0 * options.k_factor * kEarthRadius;
-    tx_top_ = ground_(tx.lat, tx.lon) + tx.height_agl;
-  }
-
-  // A receiver column: x = distances and y = terrain raised by the bulge, both of segments + 1
-  // entries, x[0] = 0, y[0] = the transmitter's top, x[segments] = distance; y[segments] is the
-  // receiver's top, set by loss().
-  struct Column {
-    double distance = 0.0, azimuth = 0.0, rx_ground = 0.0;
-    int segments = 0;
-  };
-  Column column(double rx_lat, double rx_lon, std::vector<double>& x, std::vector<double>& y) const {
-    Column c;
-    double azi2 = 0.0;
-    geod_.Inverse(tx_.lat, tx_.lon, rx_lat, rx_lon, c.distance, c.azimuth, azi2);
-    c.segments = std::max(1, static_cast<int>(std::ceil(c.distance / step_m_)));
-    x.resize(static_cast<std::size_t>(c.segments) + 1);
-    y.resize(static_cast<std::size_t>(c.segments) + 1);
-    x[0] = 0.0;
-    y[0] = tx_top_;
-    for (int m = 1; m < c.segments; ++m) {
-      const double t = static_cast<double>(m) / c.segments;
-      const double d = t * c.distance;
-      x[m] = d;
-      y[m] = ground_(tx_.lat + t * (rx_lat - tx_.lat), tx_.lon + t * (rx_lon - tx_.lon)) + d * (c.distance - d) / two_ka_;
-    }
-    x[c.segments] = c.distance;
-    c.rx_ground = ground_(rx_lat, rx_lon);
-    return c;
-  }
-
-  struct Loss {
-    double free_space = 0.0, diffraction = 0.0, gain = 0.0, departure = 0.0;
-    double total() const { return free_space + diffraction - gain; }
-  };
-  // The loss to a receiver `rx_top` metres above the datum in column c. `edges` receives
-  // Deygout's edges when given; they are needed (and found) anyway with an antenna pattern.
-  Loss loss(const Column& c, const std::vector<double>& x, std::vector<double>& y, double rx_top,
-            std::vector<KnifeEdge>* edges) const {
-    y[c.segments] = rx_top;
-    const double dh = rx_top - tx_top_;
-    const double slant = std::max(1.0, std::sqrt(c.distance * c.distance + dh * dh));
-    Loss l;
-    l.free_space = free_space_loss_db(slant, tx_.frequency_mhz);
-    if (edges) edges->clear();
-    l.diffraction = deygout(x.data(), y.data(), 0, c.segments, false, false, lambda_, options_.edge_depth, edges);
-    if (edges || tx_.antenna) {
-      // The steepest line from the transmitter, in the raised frame, less the tilt of the
-      // transmitter's local horizontal there (the bulge's slope at d = 0).
-      double slope = c.distance > 0.0 ? dh / c.distance : 0.0;
-      if (edges) {
-        for (const KnifeEdge& e : *edges) slope = std::max(slope, (y[e.sample] - tx_top_) / x[e.sample]);
-      }
-      l.departure = (std::atan(slope) - std::atan(c.distance / two_ka_)) / kDegree;
-      if (tx_.antenna) l.gain = tx_.antenna->gain_db(c.azimuth < 0.0 ? c.azimuth + 360.0 : c.azimuth, l.departure);
-    }
-    return l;
-  }
-
-  double tx_top() const { return tx_top_; }
-  double ground(double lat, double lon) const { return ground_(lat, lon); }
-  double two_ka() const { return two_ka_; }
-
- private:
-  const Transmitter& tx_;
-  const RfOptions& options_;
-  DemSampler ground_;
-  const GeographicLib::Geodesic& geod_;
-  double step_m_ = 0.0, lambda_ = 0.0, two_ka_ = 0.0, tx_top_ = 0.0;
-};
-
 }  // namespace
+
+void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
+  check_model(tx, options);
+  check_grid(grid, options);
+}
 
 double free_space_loss_db(double distance_m, double frequency_mhz) {
   return 20.0 * std::log10(4.0 * M_PI * distance_m / wavelength(frequency_mhz));
@@ -314,6 +275,180 @@ double path_loss_db(const PathProfile& p, double frequency_mhz, double k_factor,
   return free_space_loss_db(r, frequency_mhz) + diffraction_loss_db(p, frequency_mhz, k_factor, edge_depth);
 }
 
+void sample_profile(const io::Grid& dem, double tx_lat, double tx_lon, double rx_lat, double rx_lon, double step_m,
+                    TerrainProfile& out) {
+  const DemSampler ground(dem);
+  double distance = 0.0, azi1 = 0.0, azi2 = 0.0;
+  GeographicLib::Geodesic::WGS84().Inverse(tx_lat, tx_lon, rx_lat, rx_lon, distance, azi1, azi2);
+  const int segments = std::max(1, static_cast<int>(std::ceil(distance / step_m)));
+  out.distance_m = distance;
+  out.azimuth_deg = azi1 < 0.0 ? azi1 + 360.0 : azi1;
+  out.ground_m.resize(static_cast<std::size_t>(segments) + 1);
+  out.ground_m[0] = ground(tx_lat, tx_lon);
+  // Along the line the grid position is affine in the sample index: stepped from the
+  // transmitter's (the same points to rounding, without two divisions per sample).
+  const double c_tx = ground.column(tx_lon), r_tx = ground.row(tx_lat);
+  const double dc = (ground.column(rx_lon) - c_tx) / segments, dr = (ground.row(rx_lat) - r_tx) / segments;
+  for (int m = 1; m < segments; ++m) out.ground_m[static_cast<std::size_t>(m)] = ground.at(c_tx + m * dc, r_tx + m * dr);
+  out.ground_m[static_cast<std::size_t>(segments)] = ground(rx_lat, rx_lon);
+}
+
+struct ColumnModel::State {
+  Transmitter tx;
+  RfOptions options;
+  double lambda = 0.0, two_ka = 0.0;
+  // The column in the raised frame: distances, terrain heights raised by the bulge (k-factor
+  // Earth); x[0] = 0 and y[0] the transmitter's top, y[last] the receiver's top (set per height).
+  std::vector<double> x, y;
+  std::vector<KnifeEdge> edges;
+  std::optional<ItmPath> itm;
+
+  // x, y for a profile (both models: Deygout's terrain, and the departure's geometry).
+  void raise(const TerrainProfile& profile) {
+    const std::size_t n = profile.ground_m.size();
+    const int segments = static_cast<int>(n) - 1;
+    const double distance = profile.distance_m;
+    x.resize(n);
+    y.resize(n);
+    x[0] = 0.0;
+    y[0] = profile.ground_m[0] + tx.height_agl;
+    for (int m = 1; m < segments; ++m) {
+      const double t = static_cast<double>(m) / segments;
+      const double d = t * distance;
+      x[static_cast<std::size_t>(m)] = d;
+      y[static_cast<std::size_t>(m)] = profile.ground_m[static_cast<std::size_t>(m)] + d * (distance - d) / two_ka;
+    }
+    x[static_cast<std::size_t>(segments)] = distance;
+  }
+
+  // The steepest slope from the transmitter to the terrain samples (ITM's departure), -inf
+  // without samples. Precondition: raise(profile).
+  double terrain_slope() const {
+    double slope = -std::numeric_limits<double>::infinity();
+    for (std::size_t m = 1; m + 1 < x.size(); ++m) slope = std::max(slope, (y[m] - y[0]) / x[m]);
+    return slope;
+  }
+
+  // Departure elevation (degrees) of a path whose steepest line from the transmitter has
+  // `slope` in the raised frame, less the tilt of the local horizontal there (the bulge's
+  // slope at d = 0); and the pattern's gain there.
+  void departure(double slope, double distance, double azimuth, RfPath& p) const {
+    p.departure_deg = (std::atan(slope) - std::atan(distance / two_ka)) / kDegree;
+    p.antenna_gain_db = tx.antenna ? tx.antenna->gain_db(azimuth, p.departure_deg) : 0.0;
+  }
+
+  // One height's loss and its parts into p (not the profile); `want_edges`: Deygout's edges in
+  // p.edges (found anyway with a pattern). Precondition: raise(profile); for ITM the profile
+  // set on itm. `terrain` is terrain_slope() (ITM with a pattern only).
+  void evaluate(const TerrainProfile& profile, double rx_height_agl, double terrain, bool want_edges, RfPath& p) {
+    const std::size_t last = x.size() - 1;
+    const double distance = profile.distance_m;
+    const double rx_top = profile.ground_m[last] + rx_height_agl;
+    y[last] = rx_top;
+    const double dh = rx_top - y[0];
+    const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
+    const double direct = distance > 0.0 ? dh / distance : 0.0;
+    p.free_space_db = free_space_loss_db(slant, tx.frequency_mhz);
+    p.edges.clear();
+    p.itm_warning = 0;
+    if (itm) {
+      const ItmLoss r = itm->loss(rx_height_agl);
+      p.diffraction_db = r.loss_db - p.free_space_db;
+      p.itm_warning = static_cast<std::size_t>(r.warning);
+      if (tx.antenna || want_edges) departure(std::max(direct, terrain), distance, profile.azimuth_deg, p);
+      p.path_loss_db = r.loss_db - p.antenna_gain_db;
+      return;
+    }
+    const bool edges_needed = want_edges || tx.antenna.has_value();
+    p.diffraction_db = deygout(x.data(), y.data(), 0, static_cast<int>(last), false, false, lambda, options.edge_depth,
+                               edges_needed ? &p.edges : nullptr);
+    p.antenna_gain_db = 0.0;
+    if (edges_needed) {
+      // The first leg of the string over the edges: the steepest line to them or the receiver.
+      double slope = direct;
+      for (const KnifeEdge& e : p.edges) slope = std::max(slope, (y[e.sample] - y[0]) / x[e.sample]);
+      departure(slope, distance, profile.azimuth_deg, p);
+    }
+    p.path_loss_db = p.free_space_db + p.diffraction_db - p.antenna_gain_db;
+  }
+};
+
+ColumnModel::ColumnModel(const Transmitter& tx, const RfOptions& options) : s_(std::make_unique<State>()) {
+  check_model(tx, options);
+  s_->tx = tx;
+  s_->options = options;
+  s_->options.progress = nullptr;
+  s_->lambda = wavelength(tx.frequency_mhz);
+  s_->two_ka = 2.0 * options.k_factor * kEarthRadius;
+  if (options.model == RfModel::kItm) s_->itm.emplace(tx.frequency_mhz, options.itm);
+}
+
+ColumnModel::~ColumnModel() = default;
+ColumnModel::ColumnModel(ColumnModel&&) noexcept = default;
+ColumnModel& ColumnModel::operator=(ColumnModel&&) noexcept = default;
+
+std::size_t ColumnModel::path_loss(const TerrainProfile& profile, std::span<const double> heights, std::span<float> out) {
+  State& s = *s_;
+  const std::size_t n = profile.ground_m.size();
+  const double distance = profile.distance_m;
+  std::size_t warned = 0;
+  if (s.itm) {
+    if (!(distance >= kItmMinDistance)) {
+      for (float& v : out) v = std::numeric_limits<float>::quiet_NaN();
+      return 0;
+    }
+    s.itm->set_profile(profile.ground_m, distance / static_cast<double>(n - 1), s.tx.height_agl);
+    if (!s.tx.antenna) {
+      // ITM's own loss; the pattern's geometry is not needed.
+      for (std::size_t k = 0; k < heights.size(); ++k) {
+        const ItmLoss r = s.itm->loss(heights[k]);
+        out[k] = static_cast<float>(r.loss_db);
+        if (r.warning >= 3) ++warned;
+      }
+      return warned;
+    }
+  }
+  s.raise(profile);
+  const double terrain = s.itm && s.tx.antenna ? s.terrain_slope() : 0.0;
+  RfPath p;
+  for (std::size_t k = 0; k < heights.size(); ++k) {
+    s.evaluate(profile, heights[k], terrain, false, p);
+    out[k] = static_cast<float>(p.path_loss_db);
+    if (p.itm_warning >= 3) ++warned;
+  }
+  return warned;
+}
+
+void ColumnModel::path(const TerrainProfile& profile, double rx_height_agl, RfPath& out) {
+  State& s = *s_;
+  if (s.itm) {
+    if (!(profile.distance_m >= kItmMinDistance)) {
+      out = RfPath{};
+      out.free_space_db = out.diffraction_db = out.path_loss_db = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    s.itm->set_profile(profile.ground_m, profile.distance_m / static_cast<double>(profile.ground_m.size() - 1),
+                       s.tx.height_agl);
+  }
+  s.raise(profile);
+  s.evaluate(profile, rx_height_agl, s.itm ? s.terrain_slope() : 0.0, true, out);
+}
+
+std::string ColumnModel::description() const {
+  const RfOptions& o = s_->options;
+  if (o.model == RfModel::kItm) {
+    const ItmParameters& p = o.itm;
+    return "Longley-Rice ITM 1.2.2 point-to-point (Hufford's Algorithm): " +
+           std::string(p.polarization == ItmPolarization::kVertical ? "vertical" : "horizontal") +
+           " polarization, ground permittivity " + num(p.permittivity) + ", conductivity " + num(p.conductivity) +
+           " S/m, N_0 " + num(p.refractivity) + " N-units, " + itm_climate_name(p.climate) + " climate, time " +
+           num(p.time) + ", location " + num(p.location) + ", situation " + num(p.situation) + ", MDVAR " +
+           std::to_string(p.mdvar());
+  }
+  return "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " + std::to_string(o.edge_depth) +
+         " levels, earth bulge with k = " + num(o.k_factor);
+}
+
 double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km) {
   const double dem_m = dem_spacing_arcsec / 3600.0 * (M_PI / 180.0) * kEarthRadius;
   const double wanted_m = 2.0 * radius_km * 1000.0 / 256.0;
@@ -325,9 +460,9 @@ double dem_height(const io::Grid& dem, double lat, double lon) {
   return DemSampler(dem)(lat, lon);
 }
 
-RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec) {
+RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec, RfModel model) {
   RfGrid r = grid;
-  if (r.heights_agl.empty()) r.heights_agl = default_heights();
+  if (r.heights_agl.empty()) r.heights_agl = default_heights(model);
   if (r.spacing_arcsec == 0.0) r.spacing_arcsec = default_spacing_arcsec(dem_spacing_arcsec, r.radius_km);
   return r;
 }
@@ -382,33 +517,28 @@ RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double
   const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
   check_inside(e, tx.lat, tx.lon, "transmitter");
   check_inside(e, rx_lat, rx_lon, "receiver");
-  const PathModel model(dem, tx, options);
-  std::vector<double> x, y;
-  const PathModel::Column c = model.column(rx_lat, rx_lon, x, y);
+  ColumnModel model(tx, options);
+  TerrainProfile profile;
+  sample_profile(dem, tx.lat, tx.lon, rx_lat, rx_lon, profile_step_m(dem, tx), profile);
   RfPath path;
-  const double rx_top = c.rx_ground + rx_height_agl;
-  const PathModel::Loss l = model.loss(c, x, y, rx_top, &path.edges);
+  model.path(profile, rx_height_agl, path);
   std::sort(path.edges.begin(), path.edges.end(), [](const KnifeEdge& a, const KnifeEdge& b) { return a.sample < b.sample; });
-  for (KnifeEdge& edge : path.edges) --edge.sample;  // x[0] is the transmitter
+  for (KnifeEdge& edge : path.edges) --edge.sample;  // sample 0 of the column is the transmitter
+  const std::size_t segments = profile.ground_m.size() - 1;
   PathProfile& p = path.profile;
-  p.distance_m = c.distance;
-  p.tx_height_m = model.tx_top();
-  p.rx_height_m = rx_top;
-  for (int m = 1; m < c.segments; ++m) {
-    p.d_m.push_back(x[m]);
-    p.z_m.push_back(y[m] - x[m] * (c.distance - x[m]) / model.two_ka());
+  p.distance_m = profile.distance_m;
+  p.tx_height_m = profile.ground_m[0] + tx.height_agl;
+  p.rx_height_m = profile.ground_m[segments] + rx_height_agl;
+  for (std::size_t m = 1; m < segments; ++m) {
+    p.d_m.push_back(static_cast<double>(m) / static_cast<double>(segments) * profile.distance_m);
+    p.z_m.push_back(profile.ground_m[m]);
   }
-  path.azimuth_deg = c.azimuth < 0.0 ? c.azimuth + 360.0 : c.azimuth;
-  path.free_space_db = l.free_space;
-  path.diffraction_db = l.diffraction;
-  path.departure_deg = l.departure;
-  path.antenna_gain_db = l.gain;
-  path.path_loss_db = l.total();
+  path.azimuth_deg = profile.azimuth_deg;
   return path;
 }
 
 RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattice& l, std::span<const int> rows,
-                        const RfOptions& options, std::span<float> out) {
+                        const RfOptions& options, std::span<float> out, double disc_radius_km) {
   RfGrid grid;
   for (int k = 0; k < l.dims[2]; ++k) grid.heights_agl.push_back(l.world(2, k));
   check_rf_parameters(tx, grid, options);
@@ -424,31 +554,54 @@ RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattic
   for (const int j : rows) {
     if (j < 0 || j >= l.dims[1]) throw std::invalid_argument("compute_rf_rows: row " + std::to_string(j) + " is outside the lattice");
   }
-  const PathModel model(dem, tx, options);
+  const ColumnModel prototype(tx, options);  // checks the model's parameters once, here
+  const double step_m = profile_step_m(dem, tx);
   const std::size_t n_columns = nx * nr;
   const std::size_t layer = n_columns;
-  const bool with_edges = tx.antenna.has_value();
+  const std::vector<double>& heights_m = grid.heights_agl;
+
+  // The disc: decided from the flat distance in the transmitter's frame where that is clearly
+  // inside or outside (it is within 0.5% of the geodesic one over 500 km), by the geodesic
+  // near the rim.
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double mlat = frame.metres_per_degree_lat(), mlon = frame.metres_per_degree_lon();
+  const double radius_m = disc_radius_km * 1000.0;
+  auto outside_disc = [&](double lat, double lon) {
+    if (!(disc_radius_km > 0.0)) return false;
+    const double flat = std::hypot((lon - tx.lon) * mlon, (lat - tx.lat) * mlat);
+    if (flat < 0.99 * radius_m) return false;
+    if (flat > 1.01 * radius_m) return true;
+    double distance = 0.0;
+    GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, lat, lon, distance);
+    return distance > radius_m;
+  };
 
   RfStats stats;
-  std::atomic<std::size_t> done{0}, samples{0};
+  std::atomic<std::size_t> done{0}, samples{0}, warned{0}, computed{0};
   std::mutex progress_mutex;
   int reported = -1;
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_columns, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    std::vector<double> x, y;
-    std::vector<KnifeEdge> edges;
-    std::size_t local_samples = 0;
+    ColumnModel model(tx, options);
+    TerrainProfile profile;
+    std::vector<float> column(static_cast<std::size_t>(nh));
+    std::size_t local_samples = 0, local_warned = 0, local_computed = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const int i = static_cast<int>(c % nx);
       const int j = rows[c / nx];
-      const PathModel::Column column = model.column(l.world(1, j), l.world(0, i), x, y);
-      local_samples += static_cast<std::size_t>(column.segments - 1);
-      for (int k = 0; k < nh; ++k) {
-        const PathModel::Loss loss = model.loss(column, x, y, column.rx_ground + l.world(2, k), with_edges ? &edges : nullptr);
-        out[c + layer * static_cast<std::size_t>(k)] = static_cast<float>(loss.total());
+      if (outside_disc(l.world(1, j), l.world(0, i))) {
+        for (int k = 0; k < nh; ++k) out[c + layer * static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
+        continue;
       }
+      ++local_computed;
+      sample_profile(dem, tx.lat, tx.lon, l.world(1, j), l.world(0, i), step_m, profile);
+      local_samples += profile.ground_m.size() - 2;
+      local_warned += model.path_loss(profile, heights_m, column);
+      for (int k = 0; k < nh; ++k) out[c + layer * static_cast<std::size_t>(k)] = column[static_cast<std::size_t>(k)];
     }
     samples += local_samples;
+    warned += local_warned;
+    computed += local_computed;
     const std::size_t now = done += r.size();
     if (options.progress) {
       const int percent = static_cast<int>(100.0 * static_cast<double>(now) / static_cast<double>(n_columns));
@@ -460,8 +613,9 @@ RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattic
     }
   });
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  stats.columns = n_columns;
+  stats.columns = computed.load();
   stats.samples = samples.load();
+  stats.itm_warned = warned.load();
   return stats;
 }
 
@@ -480,11 +634,10 @@ Volume path_loss_volume(const Transmitter& tx, const Lattice& lattice, const RfO
       {"tx_lon", num(tx.lon)},
       {"tx_height_agl_m", num(tx.height_agl)},
       {"frequency_mhz", num(tx.frequency_mhz)},
-      {"k_factor", num(options.k_factor)},
-      {"model", "free space + Deygout knife-edge diffraction (ITU-R P.526 J(v)), " +
-                    std::to_string(options.edge_depth) + " levels, earth bulge with k = " + num(options.k_factor)},
+      {"model", ColumnModel(tx, options).description()},
       {"vertical_datum", vertical_datum},
   };
+  if (options.model == RfModel::kDeygout) loss.attributes["k_factor"] = num(options.k_factor);
   if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
   if (!tx.name.empty()) loss.attributes["tx_name"] = tx.name;
   if (tx.antenna) {
@@ -509,22 +662,45 @@ Volume signal_from_path_loss(Volume s, double erp_w) {
   return s;
 }
 
+std::vector<std::string> rf_notes(const RfStats& stats, std::size_t box_columns, std::size_t points, const RfGrid& grid,
+                                  const RfOptions& options) {
+  std::vector<std::string> notes;
+  if (grid.disc) {
+    notes.push_back("the " + std::to_string(box_columns - stats.columns) + " columns farther than " +
+                    num(grid.radius_km) + " km from the transmitter are NaN (disc)");
+  }
+  if (options.model == RfModel::kItm) {
+    notes.push_back("ITM has no value at the transmitter's own column (NaN)");
+    if (stats.itm_warned > 0) {
+      notes.push_back(std::to_string(stats.itm_warned) + " of " + std::to_string(points) +
+                      " points carry ITM warning 3 or 4: parameters outside the model's range (paths under 1 km, "
+                      "N_s under 250 N-units over high ground, steep horizons); computed anyway");
+    }
+  }
+  return notes;
+}
+
 RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
   check_rf_parameters(tx, grid_in, options);
   check_dem(dem);
   const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
   check_inside(e, tx.lat, tx.lon, "transmitter");
-  const RfGrid grid = resolve_grid(grid_in, dem.georef.dy * 3600.0);
+  const RfGrid grid = resolve_grid(grid_in, dem.georef.dy * 3600.0, options.model);
   const RfBox box = rf_box(e, tx, grid, tx.lat, tx.lon);
   RfResult result;
   if (box.clipped) result.notes.push_back("the box was clipped to the DEM's extent");
   result.path_loss = path_loss_volume(tx, box.lattice, options, dem.vertical_datum);
   std::vector<int> rows(static_cast<std::size_t>(box.lattice.dims[1]));
   for (std::size_t j = 0; j < rows.size(); ++j) rows[j] = static_cast<int>(j);
-  const RfStats stats = compute_rf_rows(dem, tx, box.lattice, rows, options, result.path_loss.values);
+  const RfStats stats = compute_rf_rows(dem, tx, box.lattice, rows, options, result.path_loss.values,
+                                        grid.disc ? grid.radius_km : 0.0);
   result.seconds = stats.seconds;
   result.columns = stats.columns;
-  result.mean_profile_samples = static_cast<double>(stats.samples) / static_cast<double>(stats.columns);
+  result.mean_profile_samples =
+      static_cast<double>(stats.samples) / static_cast<double>(std::max<std::size_t>(1, stats.columns));
+  const std::size_t box_columns = static_cast<std::size_t>(box.lattice.dims[0]) * static_cast<std::size_t>(box.lattice.dims[1]);
+  for (auto& note : rf_notes(stats, box_columns, box.lattice.size(), grid, options)) result.notes.push_back(note);
+  if (grid.disc) result.path_loss.attributes["disc_radius_km"] = num(grid.radius_km);
   if (tx.erp_w) result.signal = signal_from_path_loss(result.path_loss, *tx.erp_w);
   return result;
 }
@@ -562,7 +738,7 @@ RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& 
   check_rf_parameters(tx, grid, options);
   check_inside(dem_extent(dem.georef(), dem.rows(), dem.cols()), tx.lat, tx.lon, "transmitter");
   RfWindow window = read_rf_window(dem, rf_area(tx, grid.radius_km));
-  RfResult result = compute_rf(window.grid, tx, resolve_grid(grid, dem.georef().dy * 3600.0), options);
+  RfResult result = compute_rf(window.grid, tx, resolve_grid(grid, dem.georef().dy * 3600.0, options.model), options);
   result.notes.insert(result.notes.end(), window.notes.begin(), window.notes.end());
   result.path_loss.attributes["dem"] = window.tiles;
   if (result.signal) result.signal->attributes["dem"] = window.tiles;

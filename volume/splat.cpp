@@ -35,6 +35,7 @@
 #include <utility>
 
 #include "io/compressed.h"
+#include "io/dem_file.h"
 #include "io/error.h"
 #include "io/sdf_name.h"
 #include "volume/text.h"
@@ -477,13 +478,13 @@ std::map<std::pair<int, int>, TileFile> list_tiles(const std::filesystem::path& 
   std::map<std::pair<int, int>, TileFile> tiles;
   for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
     const std::string name = lower(entry.path().filename().string());
-    const bool plain = name.ends_with(".sdf"), bz2 = name.ends_with(".sdf.bz2");
-    if ((!plain && !bz2) || name.find("-hd") != std::string::npos)
+    if (io::format_from_name(name) != io::Format::kSdf || name.find("-hd") != std::string::npos)
       continue;  // splat-hd tiles: not ours
+    const bool plain = io::compression_from_name(name) == io::Compression::kNone;
     const auto corner = io::sdf_corner_from_name(name);
     if (!corner) continue;
     auto [it, inserted] =
-        tiles.try_emplace({corner->south, corner->west}, TileFile{entry.path(), bz2});
+        tiles.try_emplace({corner->south, corner->west}, TileFile{entry.path(), !plain});
     if (!inserted && it->second.compressed && plain)
       it->second = TileFile{entry.path(), false};  // prefer .sdf
   }
@@ -513,12 +514,7 @@ void place_tile(const TileFile& tile, const std::filesystem::path& target) {
     if (ec) throw std::runtime_error(tile.path.string() + ": cannot copy (" + ec.message() + ")");
     return;
   }
-  bool ok = false;
-  const std::string bytes = slurp(tile.path, ok);
-  if (!ok) throw std::runtime_error(tile.path.string() + ": cannot read");
-  const auto data =
-      io::bunzip2(io::Bytes(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
-                  tile.path.string(), std::size_t{1} << 26);
+  const auto data = io::read_content(tile.path);
   write_text(target, std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
 }
 
@@ -649,7 +645,7 @@ SplatRunResult run_splat(const SplatRunOptions& o) {
         std::to_string(t.first + 1) + " N, " + std::to_string(t.second) + ".." +
         std::to_string(t.second + 1) + " E (" + colon_name(t.first, t.second) + " or " +
         std::to_string(t.first) + "_" + std::to_string(t.first + 1) + "_" + std::to_string(wmin) +
-        "_" + std::to_string((wmin + 1) % 360) + ".sdf[.bz2]), which the " + num(o.radius_km) +
+        "_" + std::to_string((wmin + 1) % 360) + ".sdf, plain or compressed), which the " + num(o.radius_km) +
         " km disc around the transmitter needs (SPLAT! would take it as sea level)");
   }
   const double load_lat = o.radius_km / 1.609344 / 57.0 + 1e-6, load_lon = load_lat / coslat;
@@ -701,6 +697,7 @@ SplatRunResult run_splat(const SplatRunOptions& o) {
     std::vector<std::string> args = {exe, "-t", "tx.qth", "-L", h, "-R", num(o.radius_km), "-metric",
                                      "-erp", num(run_erp_w), "-ano", ano};
     if (o.antenna) args.push_back("-dbm");
+    if (o.olditm) args.push_back("-olditm");
     const std::string what = "splat -L " + h;
     const ChildOutcome c = run_child(args, work.path(), work.path() / log_name, o.timeout_seconds);
     if (!c.started) throw std::runtime_error(exe + ": cannot run (" + c.start_error + ")");

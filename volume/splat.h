@@ -126,12 +126,15 @@ AnoStack stack_ano(const std::vector<AnoLayer>& layers,
 
 struct SplatRunOptions {
   std::filesystem::path executable = "/usr/bin/splat";
-  std::filesystem::path sdf_folder;  // .sdf or .sdf.bz2 tiles, named as io/sdf_name.h accepts
+  std::filesystem::path sdf_folder;  // .sdf tiles, compressed or not (.sdf.gz, .sdf.bz2, ...),
+                                     // named as io/sdf_name.h accepts
   SplatSite site;                    // the transmitter
   SplatLrp lrp;                      // its model parameters (the ERP is not passed to SPLAT!)
   std::vector<double> heights_agl;   // receiver heights, metres above ground (-L), >= 0
   double radius_km = 20.0;           // SPLAT!'s -R: the radius of the computed disc, (0, 1000]
   double timeout_seconds = 600.0;    // per height; the child is killed after it
+  bool olditm = false;               // -olditm: SPLAT!'s Longley-Rice ITM (1.2.2) instead of
+                                     // its default ITWOM 3.0
   std::filesystem::path work_root;   // where the temporary working folder goes; empty: the
                                      // system's temporary folder
   bool keep_ano_texts = false;       // fill SplatRunResult::ano_texts
@@ -161,7 +164,7 @@ struct SplatRunResult {
 // colon names ("40:41:111:112.sdf": SPLAT! 1.4.2 silently assumes sea level for any tile it
 // cannot find under that name); tx.qth and tx.lrp are written (the site's name reduced to
 // letters, digits, '-', '_' and '.', since SPLAT! names its report after it); then, for each height
-// H, `splat -t tx.qth -L H -R radius -metric -erp 0 -ano OUT` runs as a child (stdin /dev/null, its
+// H, `splat -t tx.qth -L H -R radius -metric -erp 0 -ano OUT [-olditm]` runs as a child (stdin /dev/null, its
 // output kept for messages) and OUT is parsed with parse_ano. Throws std::runtime_error, one line
 // each: the executable is missing; the folder holds no tile for part of the disc (SPLAT! would take
 // it as sea level); a tile cannot be read or decompressed (io::FormatError); SPLAT! cannot be

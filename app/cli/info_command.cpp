@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/cli/commands.h"
+#include "io/compressed.h"
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "io/geographic.h"
@@ -60,6 +61,7 @@ ordered_json describe(const std::filesystem::path& path, const io::ReadOptions& 
   ordered_json j;
   j["path"] = path.string();
   j["format"] = native.format;
+  j["compression"] = io::compression_label(io::compression_from_name(path.filename().string()));
   j["rows"] = native.rows;
   j["cols"] = native.cols;
   j["valid_samples"] = io::count(native, io::Sample::kValid);
@@ -100,7 +102,10 @@ ordered_json describe(const std::filesystem::path& path, const io::ReadOptions& 
 
 void print_text(const ordered_json& j, const std::string& title) {
   std::printf("%s\n", title.c_str());
-  std::printf("  format          %s\n", format_name(j["format"].get<std::string>()).c_str());
+  std::printf("  format          %s", format_name(j["format"].get<std::string>()).c_str());
+  if (j.contains("compression") && j["compression"] != "uncompressed")
+    std::printf(", %s-compressed", j["compression"].get<std::string>().c_str());
+  std::printf("\n");
   std::printf("  grid            %d rows x %d cols\n", j["rows"].get<int>(), j["cols"].get<int>());
   if (j.contains("projection")) {
     const auto& p = j["projection"];

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   terravol::app::cli::add_splat_command(app);
   terravol::app::cli::add_compare_command(app);
   terravol::app::cli::add_image_diff_command(app);
+  terravol::app::cli::add_export_map_command(app);
   terravol::app::cli::add_profile_command(app);
   terravol::app::cli::add_query_command(app);
   terravol::bench::add_bench_command(app);

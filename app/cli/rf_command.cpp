@@ -1,8 +1,9 @@
 // `terravol rf --tx LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,...] [--tx ...] --dem DEM... -o out.vdb`:
-// path-loss volumes from the built-in propagation model (volume/propagation.h) for one
-// transmitter, or signal volumes and the best server for several (volume/plan.h), written
-// as OpenVDB. Under mpirun the rows of the transmitters' boxes are dealt out over the ranks;
-// rank 0 gathers them and writes (app/mpi_session.h).
+// path-loss volumes from a built-in propagation model (volume/propagation.h: Deygout knife
+// edges, or the Longley-Rice ITM with --model itm) for one transmitter, or signal volumes and
+// the best server for several (volume/plan.h), written as OpenVDB. Under mpirun the rows of the
+// transmitters' boxes are dealt out over the ranks; rank 0 gathers them and writes
+// (app/mpi_session.h).
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -42,11 +43,19 @@ std::string fmt(double v) {
 
 struct RfCommandOptions {
   std::vector<std::string> txs;
-  std::string tx_file, heights = "0:2000:50";
+  std::string tx_file, heights;
+  std::string model = "deygout";
+  // ITM's parameters, SPLAT!'s .lrp defaults.
+  std::string polarization = "horizontal";
+  double permittivity = 15.0, conductivity = 0.005, refractivity = 301.0;
+  int climate = 5, mdvar = 12;
+  double time = 0.5, location = 0.5, situation = 0.5;
+  std::vector<std::string> given;  // the model-specific options given on the command line
   std::vector<std::filesystem::path> dems;
   std::filesystem::path output;
   double radius_km = 20.0;
   double spacing_arcsec = 0.0;
+  bool disc = false;
   double k_factor = 4.0 / 3.0;
   int edge_depth = 2;
   int threads = 0;
@@ -61,17 +70,107 @@ struct Setup {
   volume::RfOptions options;
 };
 
+// The options only one model takes.
+constexpr const char* kDeygoutOptions[] = {"--k-factor", "--edge-depth"};
+constexpr const char* kItmOptions[] = {"--polarization", "--permittivity", "--conductivity", "--refractivity", "--climate",
+                                       "--time", "--location", "--situation", "--mdvar"};
+
+bool given(const RfCommandOptions& o, const std::string& name) {
+  return std::find(o.given.begin(), o.given.end(), name) != o.given.end();
+}
+
+// The ITM parameters from the command line; each bad value is one line naming its option.
+volume::ItmParameters itm_parameters(const RfCommandOptions& o) {
+  volume::ItmParameters p;
+  if (o.polarization == "horizontal" || o.polarization == "h") {
+    p.polarization = volume::ItmPolarization::kHorizontal;
+  } else if (o.polarization == "vertical" || o.polarization == "v") {
+    p.polarization = volume::ItmPolarization::kVertical;
+  } else {
+    throw std::runtime_error("--polarization " + o.polarization + ": must be horizontal or vertical");
+  }
+  auto range = [](const char* option, double v, bool ok, const char* what) {
+    if (!ok) throw std::runtime_error(std::string(option) + " " + fmt(v) + ": must be within " + what);
+  };
+  range("--permittivity", o.permittivity, o.permittivity > 1.0 && o.permittivity <= 100.0, "(1, 100]");
+  range("--conductivity", o.conductivity, o.conductivity > 0.0 && o.conductivity <= 100.0, "(0, 100] S/m");
+  range("--refractivity", o.refractivity, o.refractivity >= 250.0 && o.refractivity <= 400.0, "[250, 400] N-units");
+  range("--time", o.time, o.time > 0.0 && o.time < 1.0, "(0, 1)");
+  range("--location", o.location, o.location > 0.0 && o.location < 1.0, "(0, 1)");
+  range("--situation", o.situation, o.situation > 0.0 && o.situation < 1.0, "(0, 1)");
+  if (o.climate < 1 || o.climate > 7) {
+    throw std::runtime_error("--climate " + std::to_string(o.climate) +
+                             ": must be within 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 "
+                             "desert, 5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)");
+  }
+  const int mode = o.mdvar % 10;
+  if (o.mdvar < 0 || o.mdvar > 33 || mode > 3) {
+    throw std::runtime_error("--mdvar " + std::to_string(o.mdvar) +
+                             ": must be 0..3 (single message, accidental, mobile, broadcast), plus 10 without location "
+                             "variability, plus 20 without direct situation variability");
+  }
+  p.permittivity = o.permittivity;
+  p.conductivity = o.conductivity;
+  p.refractivity = o.refractivity;
+  p.climate = static_cast<volume::ItmClimate>(o.climate);
+  p.time = o.time;
+  p.location = o.location;
+  p.situation = o.situation;
+  p.variability = static_cast<volume::ItmVariability>(mode);
+  p.location_variability = (o.mdvar % 20) < 10;
+  p.situation_variability = o.mdvar < 20;
+  return p;
+}
+
+// How a message names transmitter t: its --tx text when it is the only one given.
+std::string tx_label(const RfCommandOptions& o, const std::vector<volume::Transmitter>& txs, std::size_t t) {
+  if (txs.size() == 1 && o.txs.size() == 1) return "--tx " + o.txs.front();
+  return "transmitter " + (txs[t].name.empty() ? "tx" + std::to_string(t + 1) : txs[t].name);
+}
+
 Setup check_options(const RfCommandOptions& o) {
   Setup s;
+  if (o.model == "itm") {
+    s.options.model = volume::RfModel::kItm;
+  } else if (o.model != "deygout") {
+    throw std::runtime_error("--model " + o.model + ": must be itm or deygout");
+  }
+  const bool itm = s.options.model == volume::RfModel::kItm;
+  for (const char* name : kDeygoutOptions) {
+    if (itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model deygout");
+  }
+  for (const char* name : kItmOptions) {
+    if (!itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model itm");
+  }
   if (o.txs.empty() && o.tx_file.empty()) throw std::runtime_error("give the transmitters: --tx (once or more) or --tx-file");
   for (const auto& t : o.txs) s.transmitters.push_back(parse_tx(t));
   if (!o.tx_file.empty()) {
     auto more = read_tx_file(o.tx_file);
     s.transmitters.insert(s.transmitters.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   }
-  s.grid.heights_agl = parse_heights(o.heights);
+  const std::string heights = o.heights.empty() ? (itm ? "10:2010:50" : "0:2000:50") : o.heights;
+  s.grid.heights_agl = parse_heights(heights);
+  if (itm) {
+    s.options.itm = itm_parameters(o);
+    for (std::size_t t = 0; t < s.transmitters.size(); ++t) {
+      const volume::Transmitter& tx = s.transmitters[t];
+      if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
+        throw std::runtime_error(tx_label(o, s.transmitters, t) + ": ITM takes frequencies within [20, 20000] MHz");
+      }
+      if (tx.height_agl < 0.5 || tx.height_agl > 3000.0) {
+        throw std::runtime_error(tx_label(o, s.transmitters, t) +
+                                 ": ITM takes antenna heights within [0.5, 3000] m above ground");
+      }
+    }
+    for (const double h : s.grid.heights_agl) {
+      if (h < 0.5 || h > 3000.0) {
+        throw std::runtime_error("--heights " + heights + ": ITM takes receiver heights within [0.5, 3000] m above ground");
+      }
+    }
+  }
   s.grid.radius_km = o.radius_km;
   s.grid.spacing_arcsec = o.spacing_arcsec;
+  s.grid.disc = o.disc;
   if (!(o.radius_km > 0.0 && o.radius_km <= 500.0)) {
     throw std::runtime_error("--radius-km " + fmt(o.radius_km) + ": must be within (0, 500]");
   }
@@ -213,10 +312,7 @@ void run_rf(const RfCommandOptions& o) {
     for (std::size_t t = 0; t < setup.transmitters.size(); ++t) {
       const volume::Transmitter& tx = setup.transmitters[t];
       if (tx.lat < extent.south || tx.lat > extent.north || tx.lon < extent.west || tx.lon > extent.east) {
-        const std::string which = setup.transmitters.size() == 1 && o.txs.size() == 1
-                                      ? "--tx " + o.txs.front()
-                                      : "transmitter " + (tx.name.empty() ? "tx" + std::to_string(t + 1) : tx.name);
-        throw std::runtime_error(which + ": the transmitter lies outside the DEM (" + fmt(extent.south) + ".." +
+        throw std::runtime_error(tx_label(o, setup.transmitters, t) + ": the transmitter lies outside the DEM (" + fmt(extent.south) + ".." +
                                  fmt(extent.north) + " N, " + fmt(extent.west) + ".." + fmt(extent.east) + " E)");
       }
     }
@@ -239,6 +335,8 @@ void run_rf(const RfCommandOptions& o) {
   }
   const double columns = mpi.sum(static_cast<double>(stats.columns));
   const double samples = mpi.sum(static_cast<double>(stats.samples));
+  stats.itm_warned = static_cast<std::size_t>(mpi.sum(static_cast<double>(stats.itm_warned)));
+  stats.columns = static_cast<std::size_t>(columns);
   const double seconds = mpi.max(stats.seconds), fastest = mpi.min(stats.seconds);
   read_seconds = mpi.max(read_seconds);
   if (!root) {
@@ -273,6 +371,14 @@ void run_rf(const RfCommandOptions& o) {
   std::printf(", gathering %.1f s, writing %.1f s, in all %.1f s\n", gather_seconds, write_seconds, since(t_start));
   for (const auto& n : plan->notes) std::printf("  note: %s\n", n.c_str());
   for (const auto& n : window.notes) std::printf("  note: %s\n", n.c_str());
+  std::size_t box_columns = 0, points = 0;
+  for (const auto& b : plan->boxes) {
+    box_columns += static_cast<std::size_t>(b.dims[0]) * static_cast<std::size_t>(b.dims[1]);
+    points += b.size();
+  }
+  for (const auto& n : volume::rf_notes(stats, box_columns, points, plan->grid, options)) {
+    std::printf("  note: %s\n", n.c_str());
+  }
 }
 
 }  // namespace
@@ -280,9 +386,12 @@ void run_rf(const RfCommandOptions& o) {
 void add_rf_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "rf",
-      "Path-loss volume of a transmitter over a DEM (free space + Deygout diffraction), or the signals and best "
-      "server of several, written as .vdb; under mpirun the work is split over the ranks");
+      "Path-loss volume of a transmitter over a DEM (free space + Deygout diffraction, or Longley-Rice ITM with "
+      "--model itm), or the signals and best server of several, written as .vdb; under mpirun the work is split "
+      "over the ranks");
   auto o = std::make_shared<RfCommandOptions>();
+  cmd->add_option("--model", o->model, "Propagation model: deygout or itm (Longley-Rice point-to-point)")
+      ->capture_default_str();
   cmd->add_option("--tx", o->txs,
                   "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,name=NAME][,pattern=FILE.az[:FILE.el]]"
                   "[,azimuth=DEG][,tilt=DEG]: degrees, metres above ground, MHz (default 900), W relative to a "
@@ -294,20 +403,46 @@ void add_rf_command(CLI::App& app) {
   cmd->add_option("--radius-km", o->radius_km, "Half side of the square box around each transmitter, km")
       ->capture_default_str();
   cmd->add_option("--heights", o->heights,
-                  "Receiver heights above ground, metres: START:STOP:STEP or an evenly spaced list H1,H2,...")
-      ->capture_default_str();
+                  "Receiver heights above ground, metres: START:STOP:STEP or an evenly spaced list H1,H2,... "
+                  "(default 0:2000:50, with ITM 10:2010:50)");
   cmd->add_option("--spacing", o->spacing_arcsec,
                   "Lattice spacing in latitude and longitude, arc seconds (default: a multiple of the DEM's "
                   "spacing giving at most 256 intervals across the box)");
-  cmd->add_option("--k-factor", o->k_factor, "Effective Earth radius factor")->capture_default_str();
+  cmd->add_flag("--disc", o->disc,
+                "Compute only the columns within --radius-km of the transmitter (the box's corners are "
+                "NaN): the disc SPLAT! computes");
+  cmd->add_option("--k-factor", o->k_factor, "Deygout: effective Earth radius factor")->capture_default_str();
   cmd->add_option("--edge-depth", o->edge_depth,
-                  "Deygout recursion levels (1: principal edge only; 2: plus one secondary edge each side)")
+                  "Deygout: recursion levels (1: principal edge only; 2: plus one secondary edge each side)")
+      ->capture_default_str();
+  cmd->add_option("--polarization", o->polarization, "ITM: horizontal or vertical")->capture_default_str();
+  cmd->add_option("--permittivity", o->permittivity, "ITM: relative permittivity of the ground")->capture_default_str();
+  cmd->add_option("--conductivity", o->conductivity, "ITM: ground conductivity, S/m")->capture_default_str();
+  cmd->add_option("--refractivity", o->refractivity,
+                  "ITM: surface refractivity at sea level N_0, N-units (SPLAT!'s bending constant)")
+      ->capture_default_str();
+  cmd->add_option("--climate", o->climate,
+                  "ITM: radio climate 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 desert, "
+                  "5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)")
+      ->capture_default_str();
+  cmd->add_option("--time", o->time, "ITM: fraction of time the loss is not exceeded")->capture_default_str();
+  cmd->add_option("--location", o->location, "ITM: fraction of locations")->capture_default_str();
+  cmd->add_option("--situation", o->situation, "ITM: fraction of situations (confidence)")->capture_default_str();
+  cmd->add_option("--mdvar", o->mdvar,
+                  "ITM: variability mode 0..3 (single message, accidental, mobile, broadcast), +10 without location "
+                  "variability, +20 without direct situation variability (SPLAT!: 12)")
       ->capture_default_str();
   cmd->add_option("--threads", o->threads,
                   "Threads per process (default: the cores, shared among the ranks on a node under mpirun)");
   cmd->add_flag("--force", o->force, "Replace an existing output file");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
-  cmd->callback([o] { run_rf(*o); });
+  cmd->callback([o, cmd] {
+    for (const char* name : kDeygoutOptions)
+      if (cmd->count(name) > 0) o->given.push_back(name);
+    for (const char* name : kItmOptions)
+      if (cmd->count(name) > 0) o->given.push_back(name);
+    run_rf(*o);
+  });
 }
 
 }  // namespace terravol::app::cli

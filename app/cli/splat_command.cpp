@@ -18,7 +18,9 @@
 #include "app/cli/commands.h"
 #include "app/cli/rf_args.h"
 #include "app/output/write_file.h"
+#include "io/mosaic.h"
 #include "volume/splat.h"
+#include "volume/splat_paths.h"
 #include "volume/vdb_write.h"
 
 namespace terravol::app::cli {
@@ -34,6 +36,8 @@ struct SplatCommandOptions {
   int cells_per_degree = volume::kSplatCellsPerDegree;
   bool force = false;
   bool quiet = false;
+  bool olditm = false;
+  bool check_itm = false;
 };
 
 std::string fmt(double v) {
@@ -55,6 +59,32 @@ std::filesystem::path ano_name(const std::filesystem::path& dir, double height) 
   return dir / ("splat-L" + fmt(height) + "m.ano");
 }
 
+// --check-itm: the built-in ITM on SPLAT!'s own profiles of each map (volume/splat_paths.h),
+// over the tiles SPLAT! read, one line per height.
+std::vector<std::string> check_itm(const SplatCommandOptions& o, const std::vector<std::string>& tiles,
+                                   const std::vector<volume::AnoMap>& maps, const volume::SplatSite& site,
+                                   const volume::SplatLrp& lrp, const std::vector<double>& heights) {
+  std::vector<std::filesystem::path> paths;
+  for (const auto& t : tiles) paths.push_back(o.sdf / t);
+  const io::Mosaic mosaic = io::Mosaic::open(paths);
+  const io::Grid dem = mosaic.read_window(0, 0, mosaic.rows(), mosaic.cols());
+  std::vector<std::string> lines;
+  for (std::size_t n = 0; n < maps.size(); ++n) {
+    const volume::SplatItmCheck c =
+        volume::check_itm_on_splat_profiles(dem, maps[n], site, lrp, heights[n], o.radius_km);
+    const volume::LayerComparison& k = c.comparison;
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "built-in ITM on SPLAT!'s profiles, %g m: %zu of %zu points reproduced (%zu computed "
+                  "elsewhere); r %.6f, median SPLAT! - ITM %+.4f dB, median |difference| %.4f dB, "
+                  "largest %.3f dB",
+                  heights[n], c.reproduced, c.reported, c.unmatched, k.pearson, k.median_difference,
+                  k.median_abs_difference, c.max_abs_difference);
+    lines.push_back(b);
+  }
+  return lines;
+}
+
 void run_splat_volume(const SplatCommandOptions& o) {
   const bool importing = !o.imports.empty();
   // What describes the transmitter: --tx, --qth (+ .lrp), or nothing (an import).
@@ -70,6 +100,9 @@ void run_splat_volume(const SplatCommandOptions& o) {
     throw std::runtime_error("--sdf " + o.sdf.string() + ": not used with --import");
   if (importing && !o.ano_dir.empty())
     throw std::runtime_error("--ano-dir: not used with --import");
+  if (importing && o.olditm) throw std::runtime_error("--olditm: not used with --import");
+  if (o.check_itm && (importing || !o.olditm))
+    throw std::runtime_error("--check-itm: needs a SPLAT! run with --olditm (not --import)");
   if (!importing && o.sdf.empty())
     throw std::runtime_error("--sdf: the folder of SDF tiles is required to run SPLAT!");
   if (!importing && o.cells_per_degree != volume::kSplatCellsPerDegree) {
@@ -138,6 +171,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
   std::vector<volume::AnoMap> maps;
   std::map<std::string, std::string> attributes;
   std::string summary;
+  std::vector<std::string> check_lines;
   if (importing) {
     std::string names;
     for (const auto& p : o.imports) {
@@ -158,6 +192,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     run.timeout_seconds = o.timeout_seconds;
     run.keep_ano_texts = !o.ano_dir.empty();
     run.antenna = antenna;
+    run.olditm = o.olditm;
     const bool show_progress = !o.quiet && ::isatty(2);
     if (show_progress) {
       run.progress = [n = heights.size()](std::size_t done) {
@@ -175,8 +210,9 @@ void run_splat_volume(const SplatCommandOptions& o) {
     for (const auto& t : r.tiles) tiles += (tiles.empty() ? "" : ", ") + t;
     attributes["model"] =
         "SPLAT! " + (r.version.empty() ? std::string("(version unknown)") : "v" + r.version) +
-        " area path loss (ITWOM), splat -L H -R " + fmt(o.radius_km) + " -metric " +
-        (antenna ? "-erp " + fmt(lrp.erp_w.value_or(1.0)) + " -dbm (dBm turned back into loss)" : "-erp 0");
+        " area path loss (" + (o.olditm ? "ITM" : "ITWOM") + "), splat -L H -R " + fmt(o.radius_km) + " -metric " +
+        (antenna ? "-erp " + fmt(lrp.erp_w.value_or(1.0)) + " -dbm (dBm turned back into loss)" : "-erp 0") +
+        (o.olditm ? " -olditm" : "");
     if (antenna) {
       attributes["antenna_pattern"] = antenna->describe() + "; the loss includes the pattern's attenuation (SPLAT!'s)";
     }
@@ -190,6 +226,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
       output::write_file_atomically(ano_name(o.ano_dir, heights[n]),
                                     std::vector<std::uint8_t>(text.begin(), text.end()), o.force);
     }
+    if (o.check_itm) check_lines = check_itm(o, r.tiles, maps, *site, lrp, heights);
   }
   if (site) {
     char b[64];
@@ -243,6 +280,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
   std::printf("  %zu obstructed paths, %zu duplicate points dropped\n", stack.obstructed,
               stack.duplicates);
   std::printf("  %s\n", summary.c_str());
+  for (const auto& line : check_lines) std::printf("  %s\n", line.c_str());
 }
 
 }  // namespace
@@ -261,7 +299,7 @@ void add_splat_command(CLI::App& app) {
   cmd->add_option("--lrp", o->lrp,
                   "SPLAT! .lrp file for --qth (default: the .qth's name with .lrp)");
   cmd->add_option("--sdf", o->sdf,
-                  "Folder of SDF tiles (.sdf or .sdf.bz2, e.g. ../shared/data/dem/utah_sdf)");
+                  "Folder of SDF tiles (.sdf, or compressed: .sdf.gz, .sdf.bz2, .sdf.xz, .sdf.zip; e.g. ../shared/data/dem/utah_sdf)");
   cmd->add_option("--import", o->imports,
                   "Stack existing SPLAT! -ano path-loss files instead of running SPLAT!");
   cmd->add_option("-o,--output", o->output, "The .vdb file to write")->required();
@@ -279,6 +317,11 @@ void add_splat_command(CLI::App& app) {
   cmd->add_option("--timeout", o->timeout_seconds, "Seconds allowed for each SPLAT! run")
       ->capture_default_str();
   cmd->add_option("--ano-dir", o->ano_dir, "Also keep SPLAT!'s -ano files there (splat-LHm.ano)");
+  cmd->add_flag("--olditm", o->olditm,
+                "Run SPLAT!'s Longley-Rice ITM (splat -olditm) instead of its default ITWOM");
+  cmd->add_flag("--check-itm", o->check_itm,
+                "With --olditm: also run the built-in ITM on each of SPLAT!'s own profiles and "
+                "print, per height, how far it is from what SPLAT! wrote");
   cmd->add_flag("--force", o->force, "Replace existing output files");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] { run_splat_volume(*o); });

@@ -14,18 +14,18 @@
 
 namespace terravol::app::output {
 
-std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height) {
-  const std::size_t row = static_cast<std::size_t>(width) * 3;
-  if (width <= 0 || height <= 0 || rgb.size() != row * height) {
-    throw std::invalid_argument("encode_png: " + std::to_string(rgb.size()) + " bytes for " + std::to_string(width) +
-                                "x" + std::to_string(height));
+std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> pixels, int width, int height, int channels) {
+  const std::size_t row = static_cast<std::size_t>(width) * static_cast<std::size_t>(channels);
+  if (width <= 0 || height <= 0 || (channels != 3 && channels != 4) || pixels.size() != row * height) {
+    throw std::invalid_argument("encode_png: " + std::to_string(pixels.size()) + " bytes for " + std::to_string(width) +
+                                "x" + std::to_string(height) + "x" + std::to_string(channels));
   }
   vtkNew<vtkImageData> image;
   image->SetDimensions(width, height, 1);
-  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, channels);
   auto* dst = static_cast<std::uint8_t*>(image->GetScalarPointer());
   for (int y = 0; y < height; ++y) {  // VTK's rows go bottom up
-    std::copy_n(rgb.data() + static_cast<std::size_t>(height - 1 - y) * row, row, dst + static_cast<std::size_t>(y) * row);
+    std::copy_n(pixels.data() + static_cast<std::size_t>(height - 1 - y) * row, row, dst + static_cast<std::size_t>(y) * row);
   }
   vtkNew<vtkPNGWriter> writer;
   writer->SetInputData(image);

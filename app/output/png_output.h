@@ -10,10 +10,11 @@ class vtkRenderWindow;
 
 namespace terravol::app::output {
 
-// RGB (width * height * 3 bytes, top row first) encoded as PNG with vtkPNGWriter, in memory:
-// the same pixels give the same bytes. Throws std::invalid_argument when the size does not
-// match and std::runtime_error when encoding fails.
-std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> rgb, int width, int height);
+// RGB, or RGBA when channels is 4 (width * height * channels bytes, top row first), encoded
+// as PNG with vtkPNGWriter, in memory: the same pixels give the same bytes. Throws
+// std::invalid_argument when the size does not match or channels is neither 3 nor 4, and
+// std::runtime_error when encoding fails.
+std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> pixels, int width, int height, int channels = 3);
 
 // The last frame drawn in `window` (render::window_rgb: its back buffer, not re-rendered),
 // encoded as PNG (vtkPNGWriter, in memory). Throws std::runtime_error when encoding fails.

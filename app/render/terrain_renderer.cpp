@@ -18,7 +18,8 @@
 #include <vtkRenderStepsPass.h>
 #include <vtkCullerCollection.h>
 #include <vtkRenderer.h>
-#include <vtkScalarBarActor.h>
+#include <vtkActor2D.h>
+#include <vtkImageMapper.h>
 #include <vtkTextProperty.h>
 #include <vtkShaderProperty.h>
 #include <vtkSignedCharArray.h>
@@ -36,9 +37,11 @@
 #include <thread>
 #include <stdexcept>
 
+#include "app/render/legend_image.h"
 #include "app/render/ordered_mapper.h"
 #include "app/render/vtk_camera.h"
 #include "app/scene/timing.h"
+#include "volume/colormap.h"
 
 #include <X11/Xlib.h>
 
@@ -215,6 +218,16 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   apply_color_mode();
 
   renderer_->AddActor(actor_);
+  {
+    // The legend card: RGBA, blended over the picture, bytes passed through unscaled.
+    vtkNew<vtkImageMapper> legend_mapper;
+    legend_mapper->SetInputData(legend_data_);
+    legend_mapper->SetColorWindow(255.0);
+    legend_mapper->SetColorLevel(127.5);
+    legend_actor_->SetMapper(legend_mapper);
+    legend_actor_->SetVisibility(false);
+    renderer_->AddActor2D(legend_actor_);
+  }
   if (!split_orders()) renderer_->UseDepthPeelingOff();
   renderer_->UseFXAAOff();
   renderer_->AutomaticLightCreationOff();
@@ -491,48 +504,79 @@ void TerrainRenderer::release_vertices() {
 }
 
 void TerrainRenderer::set_legend(const scene::Legend& legend) {
-  if (legend_ != nullptr) renderer_->RemoveActor2D(legend_);
-  legend_ = nullptr;
-  if (legend.colors.empty()) return;
-  vtkNew<vtkLookupTable> table;
-  const bool discrete = !legend.labels.empty();
-  table->SetNumberOfTableValues(static_cast<vtkIdType>(legend.colors.size()));
-  for (std::size_t k = 0; k < legend.colors.size(); ++k) {
-    const scene::Rgb& c = legend.colors[k];
-    table->SetTableValue(static_cast<vtkIdType>(k), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
-  }
-  if (discrete) {
-    table->IndexedLookupOn();
-    for (std::size_t k = 0; k < legend.labels.size(); ++k) {
-      table->SetAnnotation(vtkVariant(static_cast<int>(k)), legend.labels[k]);
+  legend_card_.reset();
+  legend_cache_ = {};
+  if (!legend.empty()) {
+    LegendCard card;
+    card.title = legend.title;
+    card.subtitle = legend.subtitle;
+    if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
+    card.lo = legend.lo;
+    card.hi = legend.hi;
+    // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
+    card.entries_title = legend.categories.empty() ? "isosurfaces"
+                         : legend.levels.empty()   ? legend.categories_title
+                                                   : legend.categories_title + ", isosurfaces";
+    for (const scene::LegendLevel& l : legend.categories) {
+      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
     }
-  } else {
-    table->SetTableRange(legend.lo, legend.hi);
+    for (const scene::LegendLevel& l : legend.levels) {
+      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
+    }
+    legend_card_ = std::move(card);
   }
-  table->Build();
-  legend_ = vtkSmartPointer<vtkScalarBarActor>::New();
-  legend_->SetLookupTable(table);
-  legend_->SetTitle(legend.title.c_str());
-  legend_->SetNumberOfLabels(5);
-  legend_->SetOrientationToVertical();
-  legend_->SetPosition(0.88, 0.08);
-  legend_->SetWidth(0.1);
-  legend_->SetHeight(0.5);
-  legend_->DrawBackgroundOn();
-  legend_->GetBackgroundProperty()->SetColor(0.1, 0.1, 0.1);
-  legend_->GetBackgroundProperty()->SetOpacity(0.55);
-  for (vtkTextProperty* t : {legend_->GetTitleTextProperty(), legend_->GetLabelTextProperty(),
-                             legend_->GetAnnotationTextProperty()}) {
-    t->SetColor(1.0, 1.0, 1.0);
-    t->ShadowOff();
-    t->ItalicOff();
-    t->SetFontSize(12);
+  legend_actor_->SetVisibility(false);
+}
+
+void TerrainRenderer::place_legend(int right, int top, int max_height) { legend_place_ = {right, top, max_height}; }
+
+const RgbaImage* TerrainRenderer::legend_image_for(int max_height) {
+  if (!legend_card_) return nullptr;
+  if (legend_cache_.rgba.empty() || legend_cache_height_ != max_height) {
+    legend_cache_ = legend_image(*legend_card_, max_height);
+    legend_cache_height_ = max_height;
+    legend_uploaded_ = false;
   }
-  renderer_->AddActor2D(legend_);
+  return &legend_cache_;
+}
+
+std::array<int, 2> TerrainRenderer::legend_size(int max_height) {
+  const RgbaImage* img = legend_image_for(max_height);
+  return img == nullptr ? std::array<int, 2>{0, 0} : std::array<int, 2>{img->width, img->height};
+}
+
+void TerrainRenderer::update_legend() {
+  const int* size = window_->GetSize();
+  const int w = size[0], h = size[1];
+  // Unplaced: the upper right, 10 px in, at most the window's height less 20 px.
+  const auto [right, top, max_height] =
+      legend_place_.value_or(std::array<int, 3>{w - 10, 10, std::max(1, h - 20)});
+  const RgbaImage* img = max_height > 0 ? legend_image_for(max_height) : nullptr;
+  if (img == nullptr) {
+    legend_actor_->SetVisibility(false);
+    legend_box_.reset();
+    return;
+  }
+  if (!legend_uploaded_) {
+    // vtkImageMapper draws row 0 at the bottom: the card's rows reversed.
+    legend_data_->SetDimensions(img->width, img->height, 1);
+    legend_data_->AllocateScalars(VTK_UNSIGNED_CHAR, 4);
+    auto* dst = static_cast<unsigned char*>(legend_data_->GetScalarPointer());
+    const std::size_t row = static_cast<std::size_t>(img->width) * 4;
+    for (int y = 0; y < img->height; ++y) {
+      std::memcpy(dst + static_cast<std::size_t>(img->height - 1 - y) * row, img->rgba.data() + y * row, row);
+    }
+    legend_data_->Modified();
+    legend_uploaded_ = true;
+  }
+  legend_actor_->SetPosition(right - img->width, h - top - img->height);
+  legend_actor_->SetVisibility(true);
+  legend_box_ = std::array<int, 4>{right - img->width, top, img->width, img->height};
 }
 
 double TerrainRenderer::render() {
   const auto t0 = scene::Clock::now();
+  update_legend();
   window_->Render();
   window_->WaitForCompletion();
   return scene::ms_since(t0);

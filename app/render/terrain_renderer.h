@@ -11,12 +11,14 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "app/render/legend_image.h"
 #include "app/scene/style.h"
 #include "app/scene/terrain_colors.h"
 #include "app/scene/volume_layer.h"
@@ -30,7 +32,7 @@ class vtkPolyData;
 class vtkPolyDataMapper;
 class vtkRenderer;
 class vtkRenderWindow;
-class vtkScalarBarActor;
+class vtkActor2D;
 class vtkTexture;
 
 namespace terravol::app::render {
@@ -134,10 +136,19 @@ class TerrainRenderer {
   // the background.
   void release_vertices();
 
-  // A colour legend (vtkScalarBarActor) in the lower right, or none when `legend.colors` is
-  // empty. Continuous: colours sampled evenly over [lo, hi]; discrete (isosurfaces): one
-  // swatch per entry of `labels`, colours[k] for labels[k].
+  // The colour legend, drawn as a card (legend_image: the slice's map, each isosurface level
+  // marked on it and given a swatch), or none when `legend` is empty.
   void set_legend(const scene::Legend& legend);
+  // Where render() puts the card, in window pixels from the top left: its right edge at x =
+  // right, its top at y = top, at most max_height tall (legend_image shrinks it); max_height
+  // <= 0: not drawn. Until this is called: the upper right, 10 px in, at most the window's
+  // height less 20 px.
+  void place_legend(int right, int top, int max_height);
+  // Width and height in pixels of the card at that max_height ({0, 0} without a legend).
+  std::array<int, 2> legend_size(int max_height);
+  // The card as the last render() drew it: x, y (from the top left), width, height in window
+  // pixels; none when no legend was drawn.
+  const std::optional<std::array<int, 4>>& legend_box() const { return legend_box_; }
 
   // The last rendered image (the back buffer, not re-rendered): window_rgb(window()).
   std::vector<std::uint8_t> rgb() const;
@@ -152,6 +163,8 @@ class TerrainRenderer {
 
  private:
   void apply_color_mode();
+  void update_legend();  // before each render: the card at its place and size
+  const RgbaImage* legend_image_for(int max_height);
   void install_shaders(vtkActor& actor, bool textured);
   bool split_orders() const {
     return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer;
@@ -171,7 +184,15 @@ class TerrainRenderer {
   vtkNew<vtkPolyData> merged_poly_;
   vtkSmartPointer<vtkPolyDataMapper> merged_mapper_;
   vtkNew<vtkActor> merged_actor_;
-  vtkSmartPointer<vtkScalarBarActor> legend_;
+  // The legend: the card, its image at the last max height, the actor that shows it.
+  std::optional<LegendCard> legend_card_;
+  RgbaImage legend_cache_;
+  int legend_cache_height_ = 0;
+  bool legend_uploaded_ = false;
+  std::optional<std::array<int, 3>> legend_place_;  // right, top, max height
+  std::optional<std::array<int, 4>> legend_box_;
+  vtkNew<vtkImageData> legend_data_;
+  vtkNew<vtkActor2D> legend_actor_;
   std::vector<std::uint32_t> split_terrain_, split_merged_;  // set_frame's buffers (split orders)
   std::vector<std::int8_t> split_levels_;
   vtkNew<vtkRenderer> renderer_;

@@ -185,6 +185,29 @@ void VolumeLayer::set_isosurface(std::size_t volume, std::size_t iso, const volu
   figures_.geometry_ms = ms_since(t0);
 }
 
+namespace {
+
+std::string slice_text(const volume::SliceSpec& s) {
+  char b[96];
+  switch (s.kind) {
+    case volume::SliceKind::kAgl:
+      std::snprintf(b, sizeof b, "slice %g m above ground", s.value);
+      break;
+    case volume::SliceKind::kAlt:
+      std::snprintf(b, sizeof b, "slice at %g m altitude", s.value);
+      break;
+    case volume::SliceKind::kLat:
+      std::snprintf(b, sizeof b, "slice at latitude %g", s.value);
+      break;
+    case volume::SliceKind::kLon:
+      std::snprintf(b, sizeof b, "slice at longitude %g", s.value);
+      break;
+  }
+  return b;
+}
+
+}  // namespace
+
 Legend VolumeLayer::legend() const {
   Legend legend;
   for (const auto& v : volumes_) {
@@ -199,26 +222,25 @@ Legend VolumeLayer::legend() const {
       const double last = tx.empty() ? std::min(std::floor(static_cast<double>(v->range[1])), first + 63.0) : static_cast<double>(tx.size());
       for (double k = first; k <= last; k += 1.0) {
         const glm::u8vec3 c = volume::category_color(static_cast<std::int64_t>(k));
-        legend.colors.push_back({c.r, c.g, c.b});
-        legend.labels.push_back(tx.empty() ? std::to_string(static_cast<long long>(k))
-                                           : tx[static_cast<std::size_t>(k) - 1].name);
+        legend.categories.push_back({tx.empty() ? std::to_string(static_cast<long long>(k))
+                                                : tx[static_cast<std::size_t>(k) - 1].name,
+                                     {c.r, c.g, c.b},
+                                     k});
       }
+      legend.categories_title = tx.empty() ? "categories" : "transmitters";
+      legend.subtitle = slice_text(v->spec.slices.front()) + ": categorical";
     } else if (!v->spec.slices.empty()) {
       const volume::SliceSpec& s = v->spec.slices.front();
       legend.lo = s.lo.value_or(v->range[0]);
       legend.hi = s.hi.value_or(v->range[1]);
-      const volume::Colormap map = volume::colormap_by_name(s.colormap);
-      for (int k = 0; k < 64; ++k) {
-        const glm::u8vec3 c = map.map(k / 63.0);
-        legend.colors.push_back({c.r, c.g, c.b});
-      }
-    } else {
-      for (const auto& iso : v->spec.isosurfaces) {
-        char b[48];
-        std::snprintf(b, sizeof b, "%g %s", static_cast<double>(iso.value), v->data.units.c_str());
-        legend.labels.push_back(b);
-        legend.colors.push_back({iso.color.r, iso.color.g, iso.color.b});
-      }
+      legend.colormap = std::string(volume::colormap_by_name(s.colormap).name());
+      legend.subtitle = slice_text(s) + ": " + legend.colormap;
+    }
+    for (const auto& iso : v->spec.isosurfaces) {
+      char b[48];
+      std::snprintf(b, sizeof b, "%g%s%s", static_cast<double>(iso.value), v->data.units.empty() ? "" : " ",
+                    v->data.units.c_str());
+      legend.levels.push_back({b, {iso.color.r, iso.color.g, iso.color.b}, iso.value});
     }
     break;
   }

@@ -28,14 +28,27 @@ struct MergeFigures {
   double merge_ms = 0;              // of the last merge_into()
 };
 
-// The colour legend of the volumes (the renderer draws it in the lower right): continuous,
-// colours sampled evenly over [lo, hi]; or discrete (isosurfaces), one swatch per entry of
-// `labels`, colors[k] for labels[k]. Empty colours: no legend.
+// One isosurface level in the legend: its label ("110 dB"), colour and value.
+struct LegendLevel {
+  std::string label;
+  Rgb color;
+  double value = 0.0;
+};
+
+// The colour legend of the volumes (the renderer draws it as a card, app/render/legend_image.h):
+// the field, the first slice's colour map over [lo, hi] (named in the subtitle) and every
+// isosurface level. Empty (no map, no levels): no legend.
 struct Legend {
-  std::string title;
+  std::string title;     // "path_loss_db (dB)"
+  std::string subtitle;  // "slice 300 m above ground: viridis"; empty without a slice
+  std::string colormap;  // volume::colormap_by_name; empty: no slice, no bar
   double lo = 0.0, hi = 1.0;
-  std::vector<Rgb> colors;
-  std::vector<std::string> labels;  // empty: continuous
+  std::vector<LegendLevel> levels;
+  // A categorical slice's swatches (value: the category), headed by categories_title.
+  std::vector<LegendLevel> categories;
+  std::string categories_title;  // "transmitters", "categories"
+
+  bool empty() const { return colormap.empty() && levels.empty() && categories.empty(); }
 };
 
 // A volume's value at a point (VolumeLayer::values_at).
@@ -81,10 +94,11 @@ class VolumeLayer {
   void set_isosurface(std::size_t volume, std::size_t iso, const volume::IsoSpec& spec);
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
-  // slice's range; for a "categorical" slice a swatch per category, labelled with the names of
-  // the transmitters the volume records (volume::recorded_transmitters: best_server), else with
-  // the whole numbers in the volume's range; else a swatch per isosurface. Empty (no colours)
-  // when there is none. Throws std::invalid_argument for a malformed "transmitters" attribute.
+  // slice's range, and every isosurface level with its colour; for a "categorical" slice no
+  // bar but a swatch per category (`categories`), labelled with the names of the transmitters
+  // the volume records (volume::recorded_transmitters: best_server), else with the whole
+  // numbers in the volume's range. Empty when there is none. Throws std::invalid_argument for
+  // a malformed "transmitters" attribute.
   Legend legend() const;
 
   // Each visible volume's value at (lat, lon) and height_agl metres above the ground there,

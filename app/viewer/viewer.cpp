@@ -28,6 +28,8 @@
 #include <vtkSliderWidget.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
+#include <vtkTransformPolyDataFilter.h>
 #include <vtkXRenderWindowInteractor.h>
 
 #include <X11/XKBlib.h>
@@ -54,6 +56,7 @@
 #include "app/scene/terrain_scene.h"
 #include "app/scene/timing.h"
 #include "app/scene/volume_layer.h"
+#include "app/viewer/overlay_layout.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::viewer {
@@ -114,10 +117,75 @@ std::string threshold_text(mrbsp::LodMetric m, double t) {
   return b;
 }
 
-// Slider geometry, in the slider representation's units (lengths along the slider in units of
-// the window width, widths in units of its height; vtkSliderRepresentation2D).
-constexpr double kSliderX0 = 0.62, kSliderX1 = 0.96, kSliderY = 0.1;  // normalized display
-constexpr double kEndCapLength = 0.008, kSliderLength = 0.014;
+// The slider's panel (overlay_layout.h): its height, and inside it, from the top, the title
+// (16 px text), the tube and knob, the end labels (13 px text), in pixels.
+constexpr int kSliderPanelHeight = 92;
+constexpr int kSliderPad = 8, kSliderTubeY = 48, kSliderInset = 16;
+
+// vtkSliderRepresentation2D with the extent of what it draws (tube, end caps, knob) in window
+// pixels, read back from the geometry it built (VTK 9.1 puts all three in one vtkPoints: end
+// caps 0-3 and 12-15, tube 4-7, knob 8-11, then the label's and title's anchors; lengths are
+// fractions of the window's width, thicknesses of its height) rather than predicted.
+class MeasuredSlider : public vtkSliderRepresentation2D {
+ public:
+  static MeasuredSlider* New();
+  vtkTypeMacro(MeasuredSlider, vtkSliderRepresentation2D);
+  MeasuredSlider(const MeasuredSlider&) = delete;
+  MeasuredSlider& operator=(const MeasuredSlider&) = delete;
+
+  // Builds the representation and returns the box of its tube, caps and knob (y down from the
+  // top of a window `height` pixels tall).
+  Box drawn_box(int height) { return box_of(0, 16, height); }
+  // The knob's box.
+  Box knob_box(int height) { return box_of(8, 12, height); }
+
+ protected:
+  MeasuredSlider() = default;
+  ~MeasuredSlider() override = default;
+
+ private:
+  Box box_of(int first, int end, int height) {
+    BuildRepresentation();
+    SliderXForm->Update();
+    vtkPoints* points = SliderXForm->GetOutput()->GetPoints();
+    if (points == nullptr || points->GetNumberOfPoints() < end) return {};
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (int i = first; i < end; ++i) {
+      double p[3];
+      points->GetPoint(i, p);
+      x0 = std::min(x0, p[0]);
+      x1 = std::max(x1, p[0]);
+      y0 = std::min(y0, p[1]);
+      y1 = std::max(y1, p[1]);
+    }
+    const int left = static_cast<int>(std::floor(x0)), right = static_cast<int>(std::ceil(x1));
+    const int top = height - static_cast<int>(std::ceil(y1)), bottom = height - static_cast<int>(std::floor(y0));
+    return {left, top, right - left, bottom - top};
+  }
+};
+
+vtkStandardNewMacro(MeasuredSlider);
+
+// A text actor's box in window pixels (y down), as VTK's text renderer measures it.
+Box text_box(vtkTextActor* actor, vtkViewport* viewport, int height) {
+  if (!actor->GetVisibility() || actor->GetInput() == nullptr || actor->GetInput()[0] == '\0') return {};
+  // vtkTextActor::GetBoundingBox: relative to the actor's position (viewport pixels here).
+  double b[4];
+  actor->GetBoundingBox(viewport, b);
+  const double* at = actor->GetPosition();
+  b[0] += at[0];
+  b[1] += at[0];
+  b[2] += at[1];
+  b[3] += at[1];
+  const int x0 = static_cast<int>(std::floor(b[0])), x1 = static_cast<int>(std::ceil(b[1]));
+  const int y0 = height - static_cast<int>(std::ceil(b[3])), y1 = height - static_cast<int>(std::floor(b[2]));
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+ordered_json box_json(const Box& b) {
+  if (b.empty()) return nullptr;
+  return {{"x", b.x}, {"y", b.y}, {"w", b.w}, {"h", b.h}};
+}
 
 constexpr auto kOverlayPeriod = std::chrono::milliseconds(250);
 
@@ -150,6 +218,9 @@ class Viewer {
   void set_threshold(double t);
   void sync_slider();
   void update_overlay(double agl, double speed);
+  // Places the slider, legend, overlay text and key list (lay_out_overlay) for the window's
+  // size and their current text, when either changed.
+  void lay_out();
   void write_status(double agl, double speed, const mrbsp::Camera& camera);
   void save_screenshot();
   scene::FlightInput input() const;
@@ -185,18 +256,23 @@ class Viewer {
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
   std::optional<render::Pick> pick_;  // the last Ctrl-click's point (status file)
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
+  bool layout_dirty_ = true;  // the text, the key list or the legend changed since lay_out()
+  int layout_size_[2] = {0, 0};
+  OverlayLayout layout_;
+  double knob_lo_ = 0, knob_hi_ = 0;  // the knob's centre at the range's ends, window pixels
   Clock::time_point overlay_time_;
   bool overlay_stale_ = false;
 
   // VTK.
   vtkNew<vtkXRenderWindowInteractor> interactor_;
   vtkSmartPointer<ViewerStyle> style_;
-  vtkNew<vtkSliderRepresentation2D> slider_rep_;
+  vtkNew<MeasuredSlider> slider_rep_;
   vtkNew<vtkSliderWidget> slider_;
   vtkNew<vtkCallbackCommand> slider_callback_;
   vtkNew<vtkCallbackCommand> render_callback_;
-  vtkNew<vtkTextActor> overlay_, help_text_, slider_min_, slider_max_;
+  vtkNew<vtkTextActor> overlay_, help_text_, slider_title_, slider_min_, slider_max_;
   vtkNew<vtkActor2D> slider_panel_;
+  vtkNew<vtkPoints> slider_corners_;  // the panel's, normalized viewport
 };
 
 // Key and mouse events to the viewer, and nothing else: VTK's default bindings of
@@ -311,18 +387,14 @@ Viewer::Viewer(const ViewOptions& options)
   XkbSetDetectableAutoRepeat(static_cast<Display*>(win->GetGenericDisplayId()), True, &supported);
 
   // The threshold slider, bottom right, on a log2 scale, its value in the title, on a dark
-  // translucent panel so that it reads over sky and snow alike.
+  // translucent panel so that it reads over sky and snow alike. lay_out() places them.
   {
-    vtkNew<vtkPoints> corners;
-    const double x0 = kSliderX0 - 0.025, x1 = kSliderX1 + 0.025, y0 = kSliderY - 0.085, y1 = kSliderY + 0.075;
-    for (const auto& [x, y] : {std::pair{x0, y0}, std::pair{x1, y0}, std::pair{x1, y1}, std::pair{x0, y1}}) {
-      corners->InsertNextPoint(x, y, 0.0);
-    }
+    for (int k = 0; k < 4; ++k) slider_corners_->InsertNextPoint(0.0, 0.0, 0.0);
     vtkNew<vtkCellArray> quad;
     const vtkIdType ids[4] = {0, 1, 2, 3};
     quad->InsertNextCell(4, ids);
     vtkNew<vtkPolyData> rect;
-    rect->SetPoints(corners);
+    rect->SetPoints(slider_corners_);
     rect->SetPolys(quad);
     vtkNew<vtkCoordinate> normalized;
     normalized->SetCoordinateSystemToNormalizedViewport();
@@ -334,23 +406,14 @@ Viewer::Viewer(const ViewOptions& options)
     slider_panel_->GetProperty()->SetOpacity(0.55);
     renderer.renderer()->AddActor2D(slider_panel_);
   }
-  slider_rep_->GetPoint1Coordinate()->SetCoordinateSystemToNormalizedDisplay();
-  slider_rep_->GetPoint1Coordinate()->SetValue(kSliderX0, kSliderY);
-  slider_rep_->GetPoint2Coordinate()->SetCoordinateSystemToNormalizedDisplay();
-  slider_rep_->GetPoint2Coordinate()->SetValue(kSliderX1, kSliderY);
-  slider_rep_->SetEndCapLength(kEndCapLength);
-  slider_rep_->SetSliderLength(kSliderLength);
-  slider_rep_->SetSliderWidth(0.045);
-  slider_rep_->SetTubeWidth(0.012);
-  slider_rep_->SetEndCapWidth(0.035);
-  slider_rep_->SetTitleHeight(0.026);
+  slider_rep_->GetPoint1Coordinate()->SetCoordinateSystemToDisplay();
+  slider_rep_->GetPoint2Coordinate()->SetCoordinateSystemToDisplay();
+  slider_rep_->SetTitleText("");  // slider_title_ instead, measured with the others
   slider_rep_->ShowSliderLabelOff();
   slider_rep_->GetTubeProperty()->SetColor(0.92, 0.92, 0.92);
   slider_rep_->GetCapProperty()->SetColor(0.92, 0.92, 0.92);
   slider_rep_->GetSliderProperty()->SetColor(1.0, 0.62, 0.15);
   slider_rep_->GetSelectedProperty()->SetColor(1.0, 0.85, 0.3);
-  style_text(slider_rep_->GetTitleProperty(), 16);
-  slider_rep_->GetTitleProperty()->SetBackgroundOpacity(0.0);  // the panel is behind it
   slider_->SetInteractor(interactor_);
   slider_->SetRepresentation(slider_rep_);
   slider_->SetAnimationModeToJump();
@@ -360,30 +423,27 @@ Viewer::Viewer(const ViewOptions& options)
   });
   slider_->AddObserver(vtkCommand::InteractionEvent, slider_callback_);
   slider_->EnabledOn();
+  style_text(slider_title_->GetTextProperty(), 16);
+  slider_title_->GetTextProperty()->SetBackgroundOpacity(0.0);  // the panel is behind it
+  slider_title_->GetTextProperty()->SetVerticalJustificationToTop();
+  renderer.renderer()->AddActor2D(slider_title_);
   for (vtkTextActor* end : {slider_min_.GetPointer(), slider_max_.GetPointer()}) {
     style_text(end->GetTextProperty(), 13);
     end->GetTextProperty()->BoldOff();
     end->GetTextProperty()->SetBackgroundOpacity(0.0);
     end->GetTextProperty()->SetVerticalJustificationToBottom();
-    end->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     renderer.renderer()->AddActor2D(end);
   }
   slider_min_->GetTextProperty()->SetJustificationToLeft();
-  slider_min_->SetPosition(kSliderX0, kSliderY + 0.032);
   slider_max_->GetTextProperty()->SetJustificationToRight();
-  slider_max_->SetPosition(kSliderX1, kSliderY + 0.032);
   sync_slider();
 
   // The overlay, top left, and the key list, bottom left.
-  style_text(overlay_->GetTextProperty(), 15);
+  style_text(overlay_->GetTextProperty(), kTextFonts[0]);
   overlay_->GetTextProperty()->SetVerticalJustificationToTop();
-  overlay_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  overlay_->SetPosition(0.008, 0.988);
   renderer.renderer()->AddActor2D(overlay_);
-  style_text(help_text_->GetTextProperty(), 14);
+  style_text(help_text_->GetTextProperty(), kKeyFonts[0]);
   help_text_->GetTextProperty()->SetVerticalJustificationToBottom();
-  help_text_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  help_text_->SetPosition(0.008, 0.015);
   help_text_->SetInput(kViewKeys);
   help_text_->SetVisibility(help_);
   renderer.renderer()->AddActor2D(help_text_);
@@ -450,6 +510,7 @@ void Viewer::key_press(const std::string& key) {
   } else if (key == "h") {
     help_ = !help_;
     help_text_->SetVisibility(help_);
+    layout_dirty_ = true;
   } else if (key == "Home") {
     pose_ = start_pose_;
   } else if ((key.size() == 1 && key[0] >= '1' && key[0] <= '9') || key == "bracketleft" ||
@@ -674,9 +735,10 @@ void Viewer::sync_slider() {
   const bool error = metric_ == mrbsp::LodMetric::kError;
   const std::string title = std::string("LOD threshold ") + threshold_text(metric_, t) +
                             (error ? " (screen-space error)" : " (projected area)");
-  slider_rep_->SetTitleText(title.c_str());
+  slider_title_->SetInput(title.c_str());
   slider_min_->SetInput(error ? "0.25 px  finer" : "32 px^2  finer");
   slider_max_->SetInput(error ? "coarser  16 px" : "coarser  32768 px^2");
+  layout_dirty_ = true;  // the title's width changed
 }
 
 void Viewer::draw_frame() {
@@ -697,6 +759,7 @@ void Viewer::draw_frame() {
   traversal_ms_ = f.traversal_ms;
   upload_ms_ = f.upload_ms;
   update_overlay(agl, speed);
+  lay_out();
   draw_ms_ = pipeline_->draw();
   frame_ms_ = ms_since(t0);
   if (frames_ > 0) {  // the first frame compiles shaders and uploads every vertex
@@ -744,6 +807,94 @@ void Viewer::update_overlay(double agl, double speed) {
                 degrees(pose_.lat, 'N', 'S').c_str(), degrees(pose_.lon, 'E', 'W').c_str(), pose_.alt, agl,
                 pose_.heading_deg, pose_.pitch_deg, speed);
   overlay_->SetInput((b + overlay_settings_).c_str());
+  layout_dirty_ = true;
+}
+
+void Viewer::lay_out() {
+  vtkRenderWindow* win = pipeline_->renderer().window();
+  const int* size = win->GetSize();
+  const int W = size[0], H = size[1];
+  if (!layout_dirty_ && W == layout_size_[0] && H == layout_size_[1]) return;
+  layout_dirty_ = false;
+  layout_size_[0] = W;
+  layout_size_[1] = H;
+  const int dpi = win->GetDPI();
+  // Text measured as VTK will draw it: the actor's property at the font size tried.
+  const auto measure = [dpi](vtkTextActor* actor) {
+    return [actor, dpi](int font) {
+      vtkNew<vtkTextProperty> p;
+      p->ShallowCopy(actor->GetTextProperty());
+      p->SetFontSize(font);
+      int b[4] = {0, 0, 0, 0};
+      vtkTextRenderer::GetInstance()->GetBoundingBox(p, actor->GetInput() ? actor->GetInput() : "", b, dpi);
+      // vtkTextActor draws its background 2 px beyond the glyphs' box on every side.
+      return std::array<int, 2>{b[1] - b[0] + 1 + 4, b[3] - b[2] + 1 + 4};
+    };
+  };
+  OverlayInput in;
+  in.width = W;
+  in.height = H;
+  in.slider_height = kSliderPanelHeight;
+  in.text = measure(overlay_);
+  in.keys = measure(help_text_);
+  in.keys_shown = help_;
+  render::TerrainRenderer& renderer = pipeline_->renderer();
+  in.legend = [&renderer](int max_height) { return renderer.legend_size(max_height); };
+  layout_ = lay_out_overlay(in);
+
+  // The slider: the panel, the title at its top, the tube across its middle, the end labels
+  // at its bottom.
+  const Box& sb = layout_.slider;
+  const double nx0 = double(sb.x) / W, nx1 = double(sb.right()) / W;
+  const double ny0 = 1.0 - double(sb.bottom()) / H, ny1 = 1.0 - double(sb.y) / H;
+  slider_corners_->SetPoint(0, nx0, ny0, 0.0);
+  slider_corners_->SetPoint(1, nx1, ny0, 0.0);
+  slider_corners_->SetPoint(2, nx1, ny1, 0.0);
+  slider_corners_->SetPoint(3, nx0, ny1, 0.0);
+  slider_corners_->Modified();
+  const double tube_y = H - (sb.y + kSliderTubeY);
+  slider_rep_->GetPoint1Coordinate()->SetValue(sb.x + kSliderInset, tube_y);
+  slider_rep_->GetPoint2Coordinate()->SetValue(sb.right() - kSliderInset, tube_y);
+  // VTK sizes the slider's parts as fractions of the window: lengths of its width, widths of
+  // its height (9.1), so that these are pixels.
+  slider_rep_->SetEndCapLength(8.0 / W);
+  slider_rep_->SetSliderLength(14.0 / W);
+  slider_rep_->SetSliderWidth(28.0 / H);
+  slider_rep_->SetTubeWidth(8.0 / H);
+  slider_rep_->SetEndCapWidth(22.0 / H);
+  // The title and the end labels at the largest size that fits the panel's width.
+  const int inner = sb.w - 2 * kSliderPad;
+  int title_font = 16;
+  while (title_font > 7 && measure(slider_title_)(title_font)[0] > inner) --title_font;
+  slider_title_->GetTextProperty()->SetFontSize(title_font);
+  int end_font = 13;
+  while (end_font > 6 && measure(slider_min_)(end_font)[0] + measure(slider_max_)(end_font)[0] + 12 > inner) --end_font;
+  slider_min_->GetTextProperty()->SetFontSize(end_font);
+  slider_max_->GetTextProperty()->SetFontSize(end_font);
+  slider_title_->SetPosition(sb.x + kSliderPad, H - (sb.y + kSliderPad));
+  slider_min_->SetPosition(sb.x + kSliderPad, H - (sb.bottom() - kSliderPad));
+  slider_max_->SetPosition(sb.right() - kSliderPad, H - (sb.bottom() - kSliderPad));
+  const double value = slider_rep_->GetValue();
+  slider_rep_->SetValue(slider_rep_->GetMinimumValue());
+  const auto knob_x = [&] {
+    const Box k = slider_rep_->knob_box(H);
+    return k.x + 0.5 * k.w;
+  };
+  knob_lo_ = knob_x();
+  slider_rep_->SetValue(slider_rep_->GetMaximumValue());
+  knob_hi_ = knob_x();
+  slider_rep_->SetValue(value);
+  slider_rep_->BuildRepresentation();
+
+  // The legend, the text and the key list.
+  const bool legend = !layout_.legend.empty();
+  renderer.place_legend(layout_.legend.right(), layout_.legend.y, legend ? layout_.legend_max_height : 0);
+  overlay_->SetVisibility(!layout_.text.empty());
+  overlay_->GetTextProperty()->SetFontSize(std::max(layout_.text_font, kTextFonts[1]));
+  overlay_->SetPosition(layout_.text.x + 2, H - layout_.text.y - 2);
+  help_text_->SetVisibility(help_ && !layout_.keys.empty());
+  help_text_->GetTextProperty()->SetFontSize(std::max(layout_.keys_font, kKeyFonts[1]));
+  help_text_->SetPosition(layout_.keys.x + 2, H - layout_.keys.bottom() + 2);
 }
 
 void Viewer::save_screenshot() {
@@ -775,11 +926,6 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   const int* size = pipeline_->renderer().window()->GetSize();
   const mrbsp::Frame& frame = pipeline_->last_frame();
   const render::SlideFigures& slide = pipeline_->last_slide();
-  // The slider's knob centre at the range's ends, in window pixels from the top left
-  // (vtkSliderRepresentation2D: caps at both ends, the knob slides between them).
-  const double x0 = kSliderX0 * size[0], x1 = kSliderX1 * size[0];
-  const double knob_lo = x0 + (kEndCapLength + kSliderLength / 2.0) * size[0];
-  const double knob_hi = x1 - (kEndCapLength + kSliderLength / 2.0) * size[0];
   const SliderRange r = slider_range(metric_);
   ordered_json j;
   j["frame"] = frames_;
@@ -856,12 +1002,33 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                  {"origin_lat", terrain.frame().lat0()},
                  {"origin_lon", terrain.frame().lon0()}};
   j["size"] = {size[0], size[1]};
-  j["slider"] = {{"x_min", knob_lo},
-                 {"x_max", knob_hi},
-                 {"y", (1.0 - kSliderY) * size[1]},
+  // The knob's centre at the range's ends and the tube's height, in window pixels from the
+  // top left, as the slider's representation built them.
+  j["slider"] = {{"x_min", knob_lo_},
+                 {"x_max", knob_hi_},
+                 {"y", layout_.slider.y + kSliderTubeY},
                  {"value", slider_rep_->GetValue()},
                  {"value_min", r.lo},
                  {"value_max", r.hi}};
+  // What the overlay's parts cover as drawn, window pixels from the top left ({x, y, w, h};
+  // null: not drawn): the slider is its panel with the tube, caps, knob and texts as VTK built
+  // and measured them, the texts as VTK's text renderer measures them, the legend the card's
+  // image where the renderer put it.
+  vtkRenderer* ren = pipeline_->renderer().renderer();
+  Box slider = layout_.slider;
+  slider = united(slider, slider_rep_->drawn_box(size[1]));
+  for (vtkTextActor* t : {slider_title_.GetPointer(), slider_min_.GetPointer(), slider_max_.GetPointer()}) {
+    slider = united(slider, text_box(t, ren, size[1]));
+  }
+  const auto& legend_box = pipeline_->renderer().legend_box();
+  j["overlay"] = {{"slider", box_json(slider)},
+                  {"legend", legend_box ? box_json({(*legend_box)[0], (*legend_box)[1], (*legend_box)[2], (*legend_box)[3]})
+                                        : ordered_json(nullptr)},
+                  {"text", box_json(text_box(overlay_, ren, size[1]))},
+                  {"keys", box_json(text_box(help_text_, ren, size[1]))},
+                  {"keys_shown", help_},
+                  {"text_font", layout_.text_font},
+                  {"keys_font", layout_.keys_font}};
   j["screenshots"] = screenshots_;
   j["screenshot"] = last_screenshot_.string();
   const std::string text = j.dump(2) + "\n";

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <vector>
 
+#include "compress.h"
 #include "io/error.h"
 #include "io/srtm_write.h"
 #include "shared_data.h"
@@ -19,7 +22,9 @@ float global_height(double lat, double lon) {
   return static_cast<float>(std::lround(1000.0 + 400.0 * std::sin(lat * 3.0) + 300.0 * std::cos(lon * 2.0)));
 }
 
-void write_tile(const std::filesystem::path& dir, int south, int west, float edge_offset = 0.0f) {
+// An SRTM3 tile of global_height, compressed as `extension` says (".gz", ...; "" for none).
+void write_tile(const std::filesystem::path& dir, int south, int west, float edge_offset = 0.0f,
+                const std::string& extension = "") {
   Grid g;
   g.allocate(1201, 1201);
   for (int r = 0; r < 1201; ++r)
@@ -27,9 +32,26 @@ void write_tile(const std::filesystem::path& dir, int south, int west, float edg
       g.heights[g.index(r, c)] = global_height(south + 1.0 - r / 1200.0, west + c / 1200.0);
       if (c == 0) g.heights[g.index(r, c)] += edge_offset;
     }
+  const std::string name = srtm_tile_name(south, west) + ".hgt";
   const auto bytes = encode_srtm(g);
-  std::ofstream(dir / (srtm_tile_name(south, west) + ".hgt"), std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  test::write_file_bytes(dir / (name + extension),
+                         extension.empty() ? bytes : test::compress_as(extension, bytes, name));
+}
+
+// A SPLAT! SDF tile of global_height at 3" (1200 x 1200, no shared edges), written in SPLAT!'s
+// order as its documentation gives it: the header (max west, min north, min west, max north,
+// longitudes west-positive), then rows from the south, each from the east.
+void write_sdf_tile(const std::filesystem::path& path, int south, int west, const std::string& extension) {
+  std::string text = std::to_string(-west) + "\n" + std::to_string(south) + "\n" + std::to_string(-west - 1) +
+                     "\n" + std::to_string(south + 1) + "\n";
+  text.reserve(8'000'000);
+  for (int x = 0; x < 1200; ++x)
+    for (int y = 0; y < 1200; ++y) {
+      const double lat = south + x / 1200.0, lon = west + 1.0 - (y + 1) / 1200.0;
+      text += std::to_string(static_cast<long>(global_height(lat, lon))) + "\n";
+    }
+  const test::ByteVector bytes(text.begin(), text.end());
+  test::write_file_bytes(path.string() + extension, test::compress_as(extension, bytes, path.filename().string()));
 }
 
 TEST(Mosaic, TwoByTwoTilesShareTheirEdgesAndFormOneLattice) {
@@ -66,6 +88,58 @@ TEST(Mosaic, WindowInsideOneTileLoadsOnlyThatTile) {
   EXPECT_EQ(m.loads(), 2u);
   m.read_window(20, 30, 64, 64);
   EXPECT_EQ(m.loads(), 3u) << "a one-tile cache evicted the first tile";
+}
+
+// The window is read as a whole (its tiles decoded together) or tile by tile: tile_grid()
+// of a mosaic with a one-tile cache copied by hand is the reference.
+TEST(Mosaic, WindowOverFourTilesDecodedTogetherHoldsEachTilesOwnSamples) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w, 7.0f);  // edges differ: order shows
+  const Mosaic together = Mosaic::open({dir.path()});
+  const Mosaic one_by_one = Mosaic::open({dir.path()}, {}, 1);
+  const int row0 = 1000, col0 = 1100, rows = 401, cols = 201;
+  const Grid w = together.read_window(row0, col0, rows, cols);
+  EXPECT_EQ(together.loads(), 4u);
+  std::vector<char> done(static_cast<std::size_t>(rows) * cols, 0);
+  for (std::size_t i = 0; i < one_by_one.tiles().size(); ++i) {
+    const MosaicTile& t = one_by_one.tiles()[i];
+    const Grid& g = one_by_one.tile_grid(i);
+    for (int r = std::max(row0, t.row0); r < std::min(row0 + rows, t.row0 + t.rows); ++r)
+      for (int c = std::max(col0, t.col0); c < std::min(col0 + cols, t.col0 + t.cols); ++c) {
+        const std::size_t o = static_cast<std::size_t>(r - row0) * cols + (c - col0);
+        if (done[o]) continue;  // the first tile in input order gives a shared sample
+        done[o] = 1;
+        ASSERT_EQ(w.heights[o], g.heights[g.index(r - t.row0, c - t.col0)]) << "row " << r << " column " << c;
+      }
+  }
+  EXPECT_EQ(std::count(done.begin(), done.end(), 1), static_cast<long>(rows) * cols);
+  together.read_window(row0, col0, rows, cols);
+  EXPECT_EQ(together.loads(), 4u) << "the second read comes from the cache";
+}
+
+TEST(Mosaic, WindowNeedingMoreTilesThanTheCacheReadsEachOnce) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w);
+  const Mosaic m = Mosaic::open({dir.path()}, {}, 3);
+  m.read_window(1100, 1150, 200, 100);
+  EXPECT_EQ(m.loads(), 4u);
+}
+
+TEST(Mosaic, TwoBrokenTilesInOneWindowReportTheFirstInTileOrder) {
+  test::TempDir dir;
+  for (const char* name : {"40_41_111_112.sdf", "40_41_112_113.sdf"}) std::ofstream(dir.path() / name) << "not an SDF file\n";
+  const Mosaic m = Mosaic::open({dir.path()});
+  ASSERT_EQ(m.tiles().size(), 2u);
+  for (int n = 0; n < 5; ++n) {  // the two fail in either order when decoded together
+    try {
+      m.read_window(0, 1190, 10, 20);
+      FAIL() << "expected FormatError";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find(m.tiles()[0].path.filename().string()), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Mosaic, SharedEdgeSamplesComeFromTheFirstTileOnly) {
@@ -129,6 +203,46 @@ TEST(Mosaic, TileOfTheWrongSizeIsReportedWithItsName) {
   } catch (const FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("N44W071.hgt: size 5 bytes"), std::string::npos) << e.what();
   }
+}
+
+TEST(Mosaic, CompressedSrtmTilesArePlacedFromTheirNamesAndReadLikePlainOnes) {
+  test::TempDir dir;
+  write_tile(dir.path(), 44, -72, 0.0f, ".gz");
+  write_tile(dir.path(), 44, -71, 0.0f, ".xz");
+  write_tile(dir.path(), 45, -72, 0.0f, ".zip");
+  write_tile(dir.path(), 45, -71, 0.0f, ".bz2");
+  const Mosaic m = Mosaic::open({dir.path()});
+  ASSERT_EQ(m.tiles().size(), 4u);
+  EXPECT_EQ(m.rows(), 2401);
+  EXPECT_EQ(m.cols(), 2401);
+  EXPECT_TRUE(m.gaps().empty());
+  EXPECT_EQ(m.loads(), 1u) << ".gz, .xz and .zip record their size; bzip2 does not, so that tile is read";
+  const Grid w = m.read_window(1100, 1150, 200, 100);  // across all four tiles
+  for (int r = 0; r < w.rows; ++r)
+    for (int c = 0; c < w.cols; ++c) {
+      ASSERT_EQ(w.mask[w.index(r, c)], Sample::kValid);
+      ASSERT_EQ(w.heights[w.index(r, c)], global_height(46.0 - (1100 + r) / 1200.0, -72.0 + (1150 + c) / 1200.0));
+    }
+}
+
+TEST(Mosaic, CompressedSdfTilesArePlacedFromTheirNamesWithoutBeingRead) {
+  test::TempDir dir;
+  write_sdf_tile(dir.path() / "40_41_111_112.sdf", 40, -112, ".gz");
+  write_sdf_tile(dir.path() / "40:41:110:111.sdf", 40, -111, ".xz");
+  const Mosaic m = Mosaic::open({dir.path()});
+  ASSERT_EQ(m.tiles().size(), 2u);
+  EXPECT_EQ(m.loads(), 0u);
+  EXPECT_EQ(m.rows(), 1200);
+  EXPECT_EQ(m.cols(), 2400);
+  EXPECT_EQ(m.georef().x0, -112.0);
+  const Grid w = m.read_window(0, 1190, 1200, 20);  // across the two tiles' meeting meridian
+  EXPECT_EQ(m.loads(), 2u);
+  for (int r = 0; r < w.rows; r += 7)
+    for (int c = 0; c < w.cols; ++c) {
+      ASSERT_EQ(w.mask[w.index(r, c)], Sample::kValid);
+      ASSERT_EQ(w.heights[w.index(r, c)], global_height(41.0 - (r + 1) / 1200.0, -112.0 + (1190 + c) / 1200.0))
+          << r << " " << c;
+    }
 }
 
 TEST(Mosaic, UtahSdfDirectoryIsOneMosaicOfSixTiles) {

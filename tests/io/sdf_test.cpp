@@ -190,7 +190,8 @@ TEST(Sdf, OneArcSecondTileIsToldApartByItsCount) {
 
 TEST(SdfName, ParsesUnderscoreAndColonNames) {
   for (const char* name : {"40_41_111_112.sdf.bz2", "40:41:111:112.sdf", "40_41_111_112.SDF",
-                           "40:41:111:112-hd.sdf", "40:41:111:112", "dir/40_41_111_112.sdf"}) {
+                           "40:41:111:112-hd.sdf", "40:41:111:112", "dir/40_41_111_112.sdf",
+                           "40_41_111_112.sdf.gz", "40_41_111_112.sdf.XZ", "40:41:111:112-hd.sdf.zip"}) {
     const auto c = sdf_corner_from_name(name);
     ASSERT_TRUE(c) << name;
     EXPECT_EQ(c->south, 40) << name;
@@ -214,7 +215,8 @@ TEST(SdfName, WestLongitudesWrapAndSouthernLatitudesAreNegative) {
 TEST(SdfName, RejectsMalformedNames) {
   for (const char* name :
        {"", ".sdf", "40_41_111.sdf", "40_41_111_113.sdf", "40_42_111_112.sdf", "40_41:111_112.sdf",
-        "40_41_111_112.hgt", "40_41_111_112.bz2", "40_41_111_1120.sdf", "90_91_111_112.sdf",
+        "40_41_111_112.hgt", "40_41_111_112.bz2", "40_41_111_112.gz", "40_41_111_112.sdf.tar",
+        "40_41_111_112.sdf.gz.gz", "40_41_111_1120.sdf", "90_91_111_112.sdf",
         "40_41_111_112x.sdf", "N40W112.sdf", "40_41_-1_0.sdf"}) {
     EXPECT_FALSE(sdf_corner_from_name(name)) << name;
   }

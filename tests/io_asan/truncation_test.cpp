@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <random>
 #include <vector>
 
+#include "compress.h"
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "parse_check.h"
@@ -66,6 +68,40 @@ INSTANTIATE_TEST_SUITE_P(
         if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
       return name;
     });
+
+// A real file compressed each way, then cut at every length up to 2 KiB and at spread lengths
+// past that, and with bytes flipped: decompressing and parsing gives the grid or one line.
+class CompressedTruncation : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CompressedTruncation, EveryCutAndFlipDecompressesAndParsesOrFailsWithOneLine) {
+  const std::string ext = GetParam();
+  const auto path = test::shared_dem("olinda_dem_utm25s.tif");
+  TERRAVOL_REQUIRE_SHARED(path);
+  const std::string name = path.filename().string();
+  const std::vector<std::uint8_t> packed = test::compress_as(ext, read_content(path), name);
+  auto check = [&](const std::vector<std::uint8_t>& bytes, const std::string& context) {
+    test::expect_grid_or_one_line_error(
+        [&] { return parse_dem(Format::kGeoTiff, decompress_content(bytes, "cut", name + ext), "cut", name); }, "cut",
+        context);
+  };
+  const std::size_t dense = std::min<std::size_t>(2048, packed.size());
+  for (std::size_t n = 0; n <= dense; ++n) check({packed.begin(), packed.begin() + static_cast<std::ptrdiff_t>(n)}, "length " + std::to_string(n));
+  for (std::size_t k = 1; k <= 64; ++k) {
+    const std::size_t n = dense + (packed.size() - dense) * k / 65;
+    check({packed.begin(), packed.begin() + static_cast<std::ptrdiff_t>(n)}, "length " + std::to_string(n));
+  }
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<std::size_t> at(0, packed.size() - 1);
+  for (int trial = 0; trial < 64; ++trial) {
+    std::vector<std::uint8_t> bad = packed;
+    const std::size_t i = at(rng);
+    bad[i] = static_cast<std::uint8_t>(bad[i] ^ (1u << (trial % 8)));
+    check(bad, "byte " + std::to_string(i) + " flipped");
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryCompression, CompressedTruncation, ::testing::Values(".gz", ".bz2", ".xz", ".zip"),
+                         [](const auto& param_info) { return std::string(param_info.param + 1); });
 
 // Absurd header values must be refused before anything large is allocated (ASan would report
 // an allocation over its limit; the readers refuse first).

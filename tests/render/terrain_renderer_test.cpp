@@ -137,3 +137,69 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
 
 }  // namespace
 }  // namespace terravol::app::render
+
+namespace terravol::app::render {
+namespace {
+
+// The legend on the picture: the card the renderer says it drew is where the slice's map and
+// each isosurface's swatch are in the window's pixels, blended over the background at 85%.
+TEST(TerrainRenderer, TheLegendCardShowsTheSliceMapAndASwatchPerIsosurfaceWhereItSays) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(255);
+  RenderSettings settings = two_squares_settings(scene::DrawOrder::kBsp);
+  settings.width = 400;
+  settings.height = 360;
+  TerrainRenderer renderer(s.positions, s.shading, settings);
+  renderer.set_camera(s.camera, 100.0);
+  renderer.set_frame(frame_of({}));
+  scene::Legend legend;
+  legend.title = "path_loss_db (dB)";
+  legend.subtitle = "slice 300 m above ground: viridis";
+  legend.colormap = "viridis";
+  legend.lo = 80;
+  legend.hi = 160;
+  legend.levels = {{"110 dB", {255, 0, 255}, 110.0}, {"130 dB", {255, 165, 225}, 130.0}};
+  renderer.set_legend(legend);
+  renderer.place_legend(390, 20, 300);
+  renderer.render();
+  ASSERT_TRUE(renderer.legend_box().has_value());
+  const auto [x, y, w, h] = *renderer.legend_box();
+  EXPECT_EQ(x + w, 390);
+  EXPECT_EQ(y, 20);
+  EXPECT_LE(h, 300);
+  const test::Image img = test::image_of_rgb(renderer.rgb(), 400, 360);
+  // Every pixel of each swatch colour, exactly, lies inside the box: the swatches (opaque),
+  // 14 x 14, and the marks on the bar; outside it only the green background.
+  for (const scene::LegendLevel& l : legend.levels) {
+    int inside = 0, outside = 0;
+    for (int py = 0; py < img.height; ++py)
+      for (int px = 0; px < img.width; ++px) {
+        if (img.at(px, py) != test::Rgb8{l.color[0], l.color[1], l.color[2]}) continue;
+        (px >= x && px < x + w && py >= y && py < y + h ? inside : outside) += 1;
+      }
+    EXPECT_GE(inside, 14 * 14) << l.label;
+    EXPECT_EQ(outside, 0) << l.label;
+  }
+  EXPECT_EQ(img.at(10, 10), (test::Rgb8{0, 255, 0})) << "outside the card, the background";
+  // The card's white at alpha 217 over green: (217 * 255 + 38 * 0, 255, 217 * 255 / 255 ...).
+  const test::Rgb8 card = img.at(x + 2, y + 2);
+  EXPECT_NEAR(card[0], 217, 2);
+  EXPECT_EQ(card[1], 255);
+  EXPECT_NEAR(card[2], 217, 2);
+  // The viridis bar: its top and bottom ends somewhere in the card.
+  const volume::Colormap viridis = volume::colormap_by_name("viridis");
+  for (const double t : {0.0, 1.0}) {
+    const glm::u8vec3 c = viridis.map(t);
+    bool found = false;
+    for (int py = y; py < y + h && !found; ++py)
+      for (int px = x; px < x + w && !found; ++px) found = test::same_color(img.at(px, py), {c.r, c.g, c.b}, 6);
+    EXPECT_TRUE(found) << "viridis at " << t;
+  }
+  // Not placed (max height 0): not drawn.
+  renderer.place_legend(390, 20, 0);
+  renderer.render();
+  EXPECT_FALSE(renderer.legend_box().has_value());
+}
+
+}  // namespace
+}  // namespace terravol::app::render

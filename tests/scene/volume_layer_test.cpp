@@ -48,16 +48,25 @@ TEST(VolumeLayerLegend, CategoricalSliceNamesTheRecordedTransmittersInTheirColou
   volume::Volume v = index_volume();
   v.attributes["transmitters"] = "west,45.51,6.51,30;east,45.52,6.53,30;north,45.53,6.52,20";
   const Legend l = legend_of(v, dir);
-  EXPECT_EQ(l.labels, (std::vector<std::string>{"west", "east", "north"}));
-  EXPECT_EQ(l.colors, (std::vector<Rgb>{{0x1f, 0x77, 0xb4}, {0xff, 0x7f, 0x0e}, {0x2c, 0xa0, 0x2c}}));
+  ASSERT_EQ(l.categories.size(), 3u);
+  EXPECT_EQ(l.categories_title, "transmitters");
+  EXPECT_TRUE(l.colormap.empty());
+  const std::vector<std::string> names{"west", "east", "north"};
+  const std::vector<Rgb> colours{{0x1f, 0x77, 0xb4}, {0xff, 0x7f, 0x0e}, {0x2c, 0xa0, 0x2c}};
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(l.categories[k].label, names[k]);
+    EXPECT_EQ(l.categories[k].color, colours[k]);
+    EXPECT_EQ(l.categories[k].value, static_cast<double>(k + 1));
+  }
 }
 
 TEST(VolumeLayerLegend, CategoricalSliceWithoutTransmittersCountsTheRange) {
   const test::TempDir dir;
   const Legend l = legend_of(index_volume(), dir);
-  EXPECT_EQ(l.labels, (std::vector<std::string>{"1", "2", "3"}));
-  ASSERT_EQ(l.colors.size(), 3u);
-  EXPECT_EQ(l.colors[2], (Rgb{0x2c, 0xa0, 0x2c}));
+  ASSERT_EQ(l.categories.size(), 3u);
+  EXPECT_EQ(l.categories_title, "categories");
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(l.categories[k].label, std::to_string(k + 1));
+  EXPECT_EQ(l.categories[2].color, (Rgb{0x2c, 0xa0, 0x2c}));
 }
 
 }  // namespace

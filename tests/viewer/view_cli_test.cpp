@@ -270,7 +270,7 @@ class Viewer {
   std::string stderr_text() const { return slurp(dir_.path() / "stderr"); }
   int width() const { return width_; }
   int height() const { return height_; }
-  const std::string& window() const { return window_; }
+  const std::string& window() const { return window_; }  // the X window id
 
  private:
   static std::string display_tag() {
@@ -661,6 +661,105 @@ TEST(ViewCli, CtrlClickPicksTheTerrainOrTheSliceInFrontAndShowsTheVolumesValue) 
     const std::string message = shown["message"].get<std::string>();
     EXPECT_EQ(message.rfind("pick ", 0), 0u) << message;
     EXPECT_NE(message.find("rf.vdb path_loss_db: "), std::string::npos) << message;
+    v.xdo("key q");
+    EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+  }
+}
+
+// The overlay's parts as the status gives them: {x, y, w, h} in window pixels, or none.
+struct Part {
+  std::string name;
+  int x = 0, y = 0, w = 0, h = 0;
+};
+std::vector<Part> overlay_parts(const json& s) {
+  std::vector<Part> parts;
+  for (const char* name : {"slider", "legend", "text", "keys"}) {
+    const json& b = s["overlay"][name];
+    if (b.is_null()) continue;
+    parts.push_back({name, b["x"].get<int>(), b["y"].get<int>(), b["w"].get<int>(), b["h"].get<int>()});
+  }
+  return parts;
+}
+
+// Every part drawn, inside the window, no two sharing a pixel.
+::testing::AssertionResult parts_apart(const json& s, const std::vector<std::string>& expected) {
+  const int W = s["size"][0].get<int>(), H = s["size"][1].get<int>();
+  const std::vector<Part> parts = overlay_parts(s);
+  for (const std::string& want : expected) {
+    if (std::none_of(parts.begin(), parts.end(), [&](const Part& p) { return p.name == want; })) {
+      return ::testing::AssertionFailure() << W << "x" << H << ": no " << want << " in " << s["overlay"].dump();
+    }
+  }
+  for (std::size_t a = 0; a < parts.size(); ++a) {
+    const Part& p = parts[a];
+    if (p.w <= 0 || p.h <= 0 || p.x < 0 || p.y < 0 || p.x + p.w > W || p.y + p.h > H) {
+      return ::testing::AssertionFailure() << W << "x" << H << ": " << p.name << " leaves the window: " << s["overlay"].dump();
+    }
+    for (std::size_t b = 0; b < a; ++b) {
+      const Part& q = parts[b];
+      if (std::min(p.x + p.w, q.x + q.w) > std::max(p.x, q.x) && std::min(p.y + p.h, q.y + q.h) > std::max(p.y, q.y)) {
+        return ::testing::AssertionFailure() << W << "x" << H << ": " << p.name << " overlaps " << q.name << ": "
+                                             << s["overlay"].dump();
+      }
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Pixels of the knob's orange (vtkSliderRepresentation2D, 255, 158, 38) outside the slider's box
+// and inside it, in a screenshot: the box holds what is drawn.
+std::pair<int, int> knob_pixels(const test::Image& img, const json& s) {
+  const json& b = s["overlay"]["slider"];
+  const int x0 = b["x"].get<int>(), y0 = b["y"].get<int>(), x1 = x0 + b["w"].get<int>(), y1 = y0 + b["h"].get<int>();
+  int inside = 0, outside = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      if (!test::same_color(img.at(x, y), {255, 158, 38}, 2)) continue;
+      (x >= x0 && x < x1 && y >= y0 && y < y1 ? inside : outside) += 1;
+    }
+  return {inside, outside};
+}
+
+// The legend (the slice's map and both isosurface levels), the LOD slider, the overlay text and
+// the key list: at 1280 x 720 and 800 x 600, after the window is resized with xdotool, and
+// after a metric change widens the slider's title, no two share a pixel (issue 18: at
+// 1280 x 720 the slider used to cover the legend's lowest label).
+TEST(ViewCli, TheOverlaysPartsNeverOverlapAtEitherSizeOrAfterAResize) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  ASSERT_TRUE(make_volume(vdb));
+  const std::vector<std::string> all{"slider", "legend", "text", "keys"};
+  for (const std::string size : {"1280x720", "800x600"}) {
+    Viewer v(bundled_dem() + " --camera 45.44,6.44,2600,40,-18 --window 256 --volume " + vdb.string() +
+             " --iso 110 --iso 130 --slice agl=300,colormap=viridis,range=80:160 --size " + size);
+    ASSERT_TRUE(v.start());
+    json s = v.settle();
+    EXPECT_TRUE(parts_apart(s, {"slider", "legend", "text"}));
+    EXPECT_FALSE(s["overlay"]["keys_shown"].get<bool>());
+    v.tap("h");  // the key list
+    s = v.settle();
+    EXPECT_TRUE(s["overlay"]["keys_shown"].get<bool>());
+    EXPECT_TRUE(parts_apart(s, all));
+    EXPECT_GE(s["overlay"]["keys_font"].get<int>(), 7) << "readable";
+    const auto [inside, outside] = knob_pixels(v.screenshot(), v.status());
+    EXPECT_GT(inside, 50) << size << ": the knob is drawn inside the slider's box";
+    EXPECT_EQ(outside, 0) << size;
+    v.tap("m");  // the projected-area metric: another title and end labels
+    s = v.settle();
+    EXPECT_EQ(s["metric"], "area");
+    EXPECT_TRUE(parts_apart(s, all));
+    if (size == "800x600") {
+      v.xdo("windowsize --sync " + v.window() + " 1000 640");
+      ASSERT_TRUE(v.wait_for([](const json& st) { return st["size"][0] == 1000 && st["size"][1] == 640; }, 15.0))
+          << "the resize reaches the viewer";
+      s = v.settle();
+      EXPECT_TRUE(parts_apart(s, all));
+      v.xdo("windowsize --sync " + v.window() + " 700 520");
+      ASSERT_TRUE(v.wait_for([](const json& st) { return st["size"][0] == 700 && st["size"][1] == 520; }, 15.0));
+      s = v.settle();
+      EXPECT_TRUE(parts_apart(s, all));
+    }
     v.xdo("key q");
     EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
   }

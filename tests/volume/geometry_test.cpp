@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <vtkMath.h>
 
 #include <algorithm>
 #include <cmath>
@@ -226,12 +227,37 @@ TEST(Isosurface, TerrainFollowingVolumeLiftsVerticesByTheGround) {
 
 TEST(Isosurface, DefaultColoursAreDistinctAndCycle) {
   std::set<std::array<int, 3>> seen;
-  for (std::size_t i = 0; i < 7; ++i) {
+  for (std::size_t i = 0; i < 5; ++i) {
     const glm::u8vec3 c = default_isosurface_color(i);
     seen.insert({c.r, c.g, c.b});
   }
-  EXPECT_EQ(seen.size(), 7u);
-  EXPECT_EQ(default_isosurface_color(7), default_isosurface_color(0));
+  EXPECT_EQ(seen.size(), 5u);
+  EXPECT_EQ(default_isosurface_color(5), default_isosurface_color(0));
+}
+
+// CIE L*a*b* (D65) of an sRGB colour through VTK's conversion (vtkMath), not ours.
+std::array<double, 3> lab_of(glm::u8vec3 c) {
+  std::array<double, 3> lab{};
+  vtkMath::RGBToLab(c.r / 255.0, c.g / 255.0, c.b / 255.0, &lab[0], &lab[1], &lab[2]);
+  return lab;
+}
+
+double delta_e(glm::u8vec3 a, glm::u8vec3 b) {
+  const auto p = lab_of(a), q = lab_of(b);
+  return std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+}
+
+TEST(Isosurface, DefaultColoursAreFarFromEveryColourOfEverySliceMapAndFromEachOther) {
+  for (std::size_t i = 0; i < 5; ++i) {
+    const glm::u8vec3 c = default_isosurface_color(i);
+    for (const std::string& name : colormap_names()) {
+      const Colormap map = colormap_by_name(name);
+      double nearest = 1e9;
+      for (int k = 0; k <= 1024; ++k) nearest = std::min(nearest, delta_e(c, map.map(k / 1024.0)));
+      EXPECT_GE(nearest, 25.0) << "colour " << i << " against " << name;
+    }
+    for (std::size_t j = 0; j < i; ++j) EXPECT_GE(delta_e(c, default_isosurface_color(j)), 60.0) << i << " and " << j;
+  }
 }
 
 TEST(Geometry, AppendOffsetsTheIndices) {

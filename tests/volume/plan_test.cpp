@@ -110,6 +110,30 @@ TEST(PlanShares, EveryRowOnceAndSplitsGiveTheBitsOfOneProcess) {
   }
 }
 
+// The same with the Longley-Rice model: a plan's shares over ranks are each transmitter's
+// compute_rf with ITM, to the bit (NaN at the transmitters' own columns included).
+TEST(PlanShares, ItmSplitsGiveTheBitsOfOneProcess) {
+  const io::Grid dem = hills();
+  RfOptions o;
+  o.model = RfModel::kItm;
+  const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid(), o);
+  for (const int ranks : {1, 3}) {
+    SCOPED_TRACE(ranks);
+    PlanAssembler assembler(plan, o, "");
+    for (int r = 0; r < ranks; ++r) {
+      const RowShare share = share_of(plan, r, ranks);
+      assembler.add(share, compute_share(dem, plan, share, o));
+    }
+    const std::vector<Volume> got = assembler.take();
+    for (std::size_t t = 0; t < 3; ++t) {
+      const std::vector<float> alone = compute_rf(dem, plan.transmitters[t], small_grid(), o).path_loss.values;
+      ASSERT_EQ(got[t].values.size(), alone.size());
+      EXPECT_EQ(std::memcmp(got[t].values.data(), alone.data(), alone.size() * sizeof(float)), 0) << t;
+      EXPECT_NE(got[t].attributes.at("model").find("Longley-Rice ITM"), std::string::npos);
+    }
+  }
+}
+
 TEST(PlanShares, AssemblerRefusesWrongOrMissingShares) {
   const io::Grid dem = hills();
   const RfPlan plan = plan_rf(kExtent, 3.0, three(), small_grid());

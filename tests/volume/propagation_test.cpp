@@ -12,6 +12,7 @@
 
 #include "io/mosaic.h"
 #include "volume_test_util.h"
+#include "io/scene_frame.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
 
@@ -34,6 +35,8 @@ std::pair<int, int> tx_column(const Volume& v, const Transmitter& tx) {
   return {static_cast<int>(std::lround((tx.lon - l.origin[0]) / l.spacing[0])),
           static_cast<int>(std::lround((tx.lat - l.origin[1]) / l.spacing[1]))};
 }
+
+const Transmitter kFlatTx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
 
 TEST(FreeSpace, MatchesTheTextbookFormula) {
   for (double f : {30.0, 144.0, 900.0, 2400.0, 10000.0}) {
@@ -184,54 +187,73 @@ TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
   EXPECT_NEAR(v.at(it, jt, 0), free_space_loss_db(1.0, 900.0), 1e-4);  // same point: clamped to 1 m
 }
 
-TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
+// Flat ground 100 m up, a transmitter 30 m above it, receivers at 2, 52 and 102 m, 25 km.
+RfResult flat_ground_volume(const RfOptions& options) {
   const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 25.0;
   grid.spacing_arcsec = 15.0;
   grid.heights_agl = {2.0, 52.0, 102.0};
-  const Volume v = compute_rf(flat, tx, grid).path_loss;
-  const auto [it, jt] = tx_column(v, tx);
+  return compute_rf(flat, kFlatTx, grid, options);
+}
+
+// The loss grows along the transmitter's row (east and west) and column (north) from `first`
+// lattice steps out. Beyond the radio horizon of 30 m and 2 m antennas (about 28 km at
+// k = 4/3) the far corner at 2 m is more than `excess` dB below free space, and higher
+// receivers see less loss.
+void expect_loss_grows_over_flat_ground(const Volume& v, int first, double excess) {
+  const auto [it, jt] = tx_column(v, kFlatTx);
   for (int k = 0; k < 3; ++k) {
-    for (int i = it + 1; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
-    for (int i = it - 1; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
-    for (int j = jt + 1; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
+    for (int i = it + first; i < v.lattice.dims[0]; ++i) EXPECT_GT(v.at(i, jt, k), v.at(i - 1, jt, k)) << i << " " << k;
+    for (int i = it - first; i >= 0; --i) EXPECT_GT(v.at(i, jt, k), v.at(i + 1, jt, k)) << i << " " << k;
+    for (int j = jt + first; j < v.lattice.dims[1]; ++j) EXPECT_GT(v.at(it, j, k), v.at(it, j - 1, k)) << j << " " << k;
   }
-  // Beyond the radio horizon of 30 m and 2 m antennas (about 28 km at k = 4/3), the bulge
-  // diffracts: the far corner at 2 m is well below free space... and higher receivers see more.
   const int far = v.lattice.dims[0] - 1;
-  const double d = geodesic_m(tx.lat, tx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
-  EXPECT_GT(v.at(far, 0, 0), free_space_loss_db(d, 900.0) + 6.0);
+  const double d = geodesic_m(kFlatTx.lat, kFlatTx.lon, v.lattice.world(1, 0), v.lattice.world(0, far));
+  EXPECT_GT(v.at(far, 0, 0), free_space_loss_db(d, 900.0) + excess);
   EXPECT_LT(v.at(far, 0, 2), v.at(far, 0, 0));
 }
 
-TEST(Rf, LossGrowsBehindARidge) {
-  // A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of the transmitter.
+TEST(Rf, LossGrowsWithDistanceOverFlatGround) {
+  expect_loss_grows_over_flat_ground(flat_ground_volume(RfOptions{}).path_loss, 1, 6.0);
+}
+
+// A 400 m north-south ridge between 6.55 and 6.56 E, about 4 km east of a transmitter 30 m up;
+// receivers at 10..810 m every 200 m, 12 km.
+Volume ridge_volume(const RfOptions& options) {
   const io::Grid dem = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
-  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 12.0;
   grid.spacing_arcsec = 30.0;
   grid.heights_agl = {10.0, 210.0, 410.0, 610.0, 810.0};
-  const Volume v = compute_rf(dem, tx, grid).path_loss;
+  return compute_rf(dem, kFlatTx, grid, options).path_loss;
+}
+
+// Deep shadow at the east edge, falling as the receiver rises out of it, and every column east
+// of the ridge in its shadow at 10 m.
+void expect_shadow_behind_the_ridge(const Volume& v) {
+  const Transmitter& tx = kFlatTx;
   const auto [it, jt] = tx_column(v, tx);
-  const int east = v.lattice.dims[0] - 1, west = 0;
+  const int east = v.lattice.dims[0] - 1;
   ASSERT_GT(v.lattice.world(0, east), 6.6);
   const double d_east = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, east));
-  const double d_west = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, west));
-  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);  // deep shadow
-  // The open side: the bulge of flat ground leaves about half a Fresnel zone of clearance at
-  // 12 km for 30 m and 10 m antennas, so the loss is close to free space.
-  EXPECT_NEAR(v.at(west, jt, 0), free_space_loss_db(std::hypot(d_west, 20.0), 900.0), 2.0);
-  // Behind the ridge the loss falls as the receiver rises out of the shadow.
+  EXPECT_GT(v.at(east, jt, 0), free_space_loss_db(d_east, 900.0) + 20.0);
   for (int k = 1; k < 5; ++k) EXPECT_LT(v.at(east, jt, k), v.at(east, jt, k - 1)) << k;
-  // Every column east of the ridge at 10 m is in its shadow.
   for (int i = it; i < v.lattice.dims[0]; ++i) {
     if (v.lattice.world(0, i) <= 6.565) continue;
     const double d = geodesic_m(tx.lat, tx.lon, tx.lat, v.lattice.world(0, i));
     EXPECT_GT(v.at(i, jt, 0), free_space_loss_db(d, 900.0) + 15.0) << i;
   }
+}
+
+TEST(Rf, LossGrowsBehindARidge) {
+  const Volume v = ridge_volume(RfOptions{});
+  expect_shadow_behind_the_ridge(v);
+  // The open side: the bulge of flat ground leaves about half a Fresnel zone of clearance at
+  // 12 km for 30 m and 10 m antennas, so the loss is close to free space.
+  const auto [it, jt] = tx_column(v, kFlatTx);
+  const double d_west = geodesic_m(kFlatTx.lat, kFlatTx.lon, kFlatTx.lat, v.lattice.world(0, 0));
+  EXPECT_NEAR(v.at(0, jt, 0), free_space_loss_db(std::hypot(d_west, 20.0), 900.0), 2.0);
 }
 
 TEST(Rf, SignalIsEirpMinusPathLoss) {
@@ -349,7 +371,9 @@ TEST(RfPath, DepartureIsTheSteepestLegAboveTheTransmittersHorizon) {
   EXPECT_GT(behind.departure_deg, 4.0);
 }
 
-TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
+// Over flat ground every path is clear, so with either model the departure is the line to the
+// receiver, and the pattern's attenuation is the model's loss with it less the loss without.
+void expect_pattern_attenuation_along_the_departure(const RfOptions& options) {
   const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
   Transmitter tx{45.5, 6.5, 40.0, 900.0, 10.0, {}, {}};
   AntennaPattern pattern;
@@ -359,9 +383,9 @@ TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
   grid.radius_km = 3.0;
   grid.spacing_arcsec = 30.0;
   grid.heights_agl = {10.0, 510.0};
-  const Volume plain = compute_rf(flat, tx, grid).path_loss;
+  const Volume plain = compute_rf(flat, tx, grid, options).path_loss;
   tx.antenna = pattern;
-  const RfResult with = compute_rf(flat, tx, grid);
+  const RfResult with = compute_rf(flat, tx, grid, options);
   EXPECT_NE(with.path_loss.attributes.at("antenna_pattern").find("t.az:t.el"), std::string::npos);
   const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
   const Lattice& l = plain.lattice;
@@ -383,6 +407,168 @@ TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
   EXPECT_GT(checked, 100);
   // The signal follows: ERP in the pattern's strongest direction, less the pattern elsewhere.
   EXPECT_NEAR(with.signal->values[5] + with.path_loss.values[5], 10.0 * std::log10(10.0) + 30.0 + 2.15, 1e-3);
+}
+
+TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) { expect_pattern_attenuation_along_the_departure({}); }
+
+RfOptions itm_options() {
+  RfOptions o;
+  o.model = RfModel::kItm;
+  return o;
+}
+
+// Rolling hills of +-250 m, and a transmitter 20 m above them at 450 MHz.
+io::Grid hilly_dem() {
+  return synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
+}
+const Transmitter kHillyTx{45.5, 6.5, 20.0, 450.0, std::nullopt, {}, {}};
+
+TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {2.0, 52.0, 102.0};
+  RfOptions o = itm_options();
+  o.itm.climate = ItmClimate::kMaritimeTemperateOverLand;
+  o.itm.time = 0.9;
+  const Volume v = compute_rf(dem, tx, grid, o).path_loss;
+  EXPECT_NE(v.attributes.at("model").find("Longley-Rice ITM"), std::string::npos);
+  EXPECT_FALSE(v.attributes.contains("k_factor"));
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double step = std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
+  const std::pair<int, int> columns[] = {{0, 0}, {3, 7}, {v.lattice.dims[0] - 1, 5}, {12, v.lattice.dims[1] - 1}};
+  for (const auto& [i, j] : columns) {
+    TerrainProfile profile;
+    sample_profile(dem, tx.lat, tx.lon, v.lattice.world(1, j), v.lattice.world(0, i), step, profile);
+    const double spacing = profile.distance_m / static_cast<double>(profile.ground_m.size() - 1);
+    for (int k = 0; k < 3; ++k) {
+      const ItmLoss expected = itm_point_to_point(profile.ground_m, spacing, tx.height_agl, grid.heights_agl[k], tx.frequency_mhz, o.itm);
+      EXPECT_FLOAT_EQ(v.at(i, j, k), static_cast<float>(expected.loss_db)) << i << " " << j << " " << k;
+    }
+  }
+}
+
+TEST(RfItm, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
+  expect_pattern_attenuation_along_the_departure(itm_options());
+}
+
+// rf_path with ITM is compute_rf's value at the lattice point, its terms add up, it has no
+// knife edges, and its departure is the steepest line over the profile (by hand from the
+// profile it returns: the terrain raised by the k-factor bulge).
+TEST(RfItm, PathEqualsComputeRfAndDepartsAlongTheSteepestLineOverTheTerrain) {
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {2.0, 102.0};
+  const RfOptions o = itm_options();
+  const Volume v = compute_rf(dem, tx, grid, o).path_loss;
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  std::mt19937 rng(1919);
+  int checked = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int i = std::uniform_int_distribution<int>(0, v.lattice.dims[0] - 1)(rng);
+    const int j = std::uniform_int_distribution<int>(0, v.lattice.dims[1] - 1)(rng);
+    const int k = std::uniform_int_distribution<int>(0, 1)(rng);
+    if (std::isnan(v.at(i, j, k))) continue;  // the transmitter's column
+    const RfPath p = rf_path(dem, tx, v.lattice.world(1, j), v.lattice.world(0, i), v.lattice.world(2, k), o);
+    ASSERT_EQ(static_cast<float>(p.path_loss_db), v.at(i, j, k)) << i << " " << j << " " << k;
+    EXPECT_TRUE(p.edges.empty());
+    EXPECT_NEAR(p.path_loss_db, p.free_space_db + p.diffraction_db, 1e-9);
+    const PathProfile& q = p.profile;
+    double slope = (q.rx_height_m - q.tx_height_m) / q.distance_m;
+    for (std::size_t m = 0; m < q.d_m.size(); ++m) {
+      slope = std::max(slope, (q.z_m[m] + q.d_m[m] * (q.distance_m - q.d_m[m]) / two_ka - q.tx_height_m) / q.d_m[m]);
+    }
+    EXPECT_NEAR(p.departure_deg, (std::atan(slope) - std::atan(q.distance_m / two_ka)) * 180.0 / M_PI, 1e-9);
+    ++checked;
+  }
+  EXPECT_GT(checked, 50);
+}
+
+TEST(Rf, DiscLeavesTheColumnsBeyondTheRadiusNaNAndTheOthersAsTheBox) {
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
+  RfGrid grid;
+  grid.radius_km = 5.0;
+  grid.spacing_arcsec = 15.0;
+  grid.heights_agl = {2.0, 52.0};
+  for (const RfModel model : {RfModel::kDeygout, RfModel::kItm}) {
+    RfOptions o;
+    o.model = model;
+    const RfResult box = compute_rf(dem, tx, grid, o);
+    grid.disc = true;
+    const RfResult disc = compute_rf(dem, tx, grid, o);
+    grid.disc = false;
+    const Lattice& l = box.path_loss.lattice;
+    ASSERT_EQ(disc.path_loss.lattice.dims, l.dims);
+    std::size_t inside = 0;
+    for (int j = 0; j < l.dims[1]; ++j)
+      for (int i = 0; i < l.dims[0]; ++i) {
+        const bool in = geodesic_m(tx.lat, tx.lon, l.world(1, j), l.world(0, i)) <= 5000.0;
+        inside += in;
+        for (int k = 0; k < 2; ++k) {
+          if (in) {
+            ASSERT_EQ(std::isnan(disc.path_loss.at(i, j, k)), std::isnan(box.path_loss.at(i, j, k)));
+            if (!std::isnan(box.path_loss.at(i, j, k))) {
+              ASSERT_EQ(disc.path_loss.at(i, j, k), box.path_loss.at(i, j, k));
+            }
+          } else {
+            ASSERT_TRUE(std::isnan(disc.path_loss.at(i, j, k))) << i << " " << j;
+          }
+        }
+      }
+    EXPECT_EQ(disc.columns, inside);
+    EXPECT_NEAR(static_cast<double>(inside) / static_cast<double>(l.dims[0] * l.dims[1]), M_PI / 4.0, 0.03);
+  }
+}
+
+TEST(RfItm, LossGrowsWithDistanceOverFlatGroundAndHasNoValueAtTheTransmitter) {
+  const RfResult r = flat_ground_volume(itm_options());
+  expect_loss_grows_over_flat_ground(r.path_loss, 2, 10.0);
+  const auto [it, jt] = tx_column(r.path_loss, kFlatTx);
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isnan(r.path_loss.at(it, jt, k)));
+  ASSERT_FALSE(r.notes.empty());
+  EXPECT_EQ(r.notes[0], "ITM has no value at the transmitter's own column (NaN)");
+}
+
+TEST(RfItm, LossGrowsBehindARidge) { expect_shadow_behind_the_ridge(ridge_volume(itm_options())); }
+
+TEST(RfItm, RejectsParametersOutsideTheModelsRange) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
+  RfGrid grid;
+  grid.radius_km = 2.0;
+  grid.heights_agl = {10.0};
+  auto message = [&](const Transmitter& tx, const RfGrid& g, const RfOptions& o) {
+    try {
+      compute_rf(flat, tx, g, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  RfOptions o = itm_options();
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 10.0, std::nullopt, {}, {}}, grid, o),
+            "ITM frequency 10 MHz: must be within [20, 20000] MHz");
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 0.2, 900.0, std::nullopt, {}, {}}, grid, o),
+            "transmitter height 0.2: ITM takes antenna heights within [0.5, 3000] m above ground");
+  RfGrid low = grid;
+  low.heights_agl = {0.0, 50.0};
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, low, o),
+            "height 0: ITM takes antenna heights within [0.5, 3000] m above ground");
+  o.itm.climate = static_cast<ItmClimate>(0);
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, grid, o).rfind("ITM climate 0: must be within 1..7", 0), 0u);
+  // The default heights start at 10 m for ITM, 0 for Deygout.
+  RfGrid defaults;
+  defaults.radius_km = 1.0;
+  defaults.spacing_arcsec = 30.0;
+  const Lattice l = compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, defaults, itm_options()).path_loss.lattice;
+  EXPECT_EQ(l.dims[2], 41);
+  EXPECT_EQ(l.world(2, 0), 10.0);
+  EXPECT_EQ(l.world(2, 40), 2010.0);
 }
 
 TEST(Rf, WritesAVdbThatReadsBackBothGrids) {

@@ -54,6 +54,23 @@ TEST(RfCli, NeverOverwritesWithoutForce) {
   EXPECT_FALSE(read_volume(out).attributes.contains("erp_w"));
 }
 
+TEST(RfCli, ItmRunHasNoValueOnlyAtTheTransmitter) {
+  test::TempDir dir;
+  const auto out = dir.path() / "itm.vdb";
+  const auto r = run_terravol("rf --model itm --tx 45.5,6.5,30,450 --dem " + bundled_dem() +
+                              " --radius-km 3 --heights 10:110:50 --climate 6 --time 0.9 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("note: ITM has no value at the transmitter's own column (NaN)"), std::string::npos) << r.out;
+  const Volume loss = read_volume(out);
+  EXPECT_EQ(loss.lattice.dims[2], 3);
+  std::size_t nan = 0;
+  for (const float v : loss.values) nan += std::isnan(v) ? 1 : 0;
+  EXPECT_EQ(nan, 3u);
+  const std::string model = loss.attributes.at("model");
+  EXPECT_NE(model.find("Longley-Rice ITM"), std::string::npos) << model;
+  EXPECT_NE(model.find("maritime temperate over land climate, time 0.9"), std::string::npos) << model;
+}
+
 TEST(RfCli, BadOptionsFailWithOneLine) {
   test::TempDir dir;
   const std::string dem = " --dem " + bundled_dem();
@@ -71,6 +88,22 @@ TEST(RfCli, BadOptionsFailWithOneLine) {
       {"--tx 45.5,6.5,30 --heights a:b:c" + dem + out, "--heights a:b:c: expected START:STOP:STEP"},
       {"--tx 45.5,6.5,30 --radius-km 0" + dem + out, "--radius-km 0: must be within (0, 500]"},
       {"--tx 45.5,6.5,30" + dem + " -o " + (dir.path() / "x.png").string(), "-o " + (dir.path() / "x.png").string() + ": expected a .vdb"},
+      {"--model foo --tx 45.5,6.5,30" + dem + out, "--model foo: must be itm or deygout"},
+      {"--model itm --tx 45.5,6.5,30,10" + dem + out, "--tx 45.5,6.5,30,10: ITM takes frequencies within [20, 20000] MHz"},
+      {"--model itm --tx 45.5,6.5,30,25000" + dem + out, "--tx 45.5,6.5,30,25000: ITM takes frequencies within [20, 20000] MHz"},
+      {"--model itm --tx 45.5,6.5,0.2" + dem + out, "--tx 45.5,6.5,0.2: ITM takes antenna heights within [0.5, 3000] m"},
+      {"--model itm --tx 45.5,6.5,30 --heights 0:100:50" + dem + out,
+       "--heights 0:100:50: ITM takes receiver heights within [0.5, 3000] m above ground"},
+      {"--model itm --tx 45.5,6.5,30 --climate 9" + dem + out, "--climate 9: must be within 1..7 (1 equatorial"},
+      {"--model itm --tx 45.5,6.5,30 --time 1.5" + dem + out, "--time 1.5: must be within (0, 1)"},
+      {"--model itm --tx 45.5,6.5,30 --situation 0" + dem + out, "--situation 0: must be within (0, 1)"},
+      {"--model itm --tx 45.5,6.5,30 --permittivity 0.5" + dem + out, "--permittivity 0.5: must be within (1, 100]"},
+      {"--model itm --tx 45.5,6.5,30 --conductivity 0" + dem + out, "--conductivity 0: must be within (0, 100] S/m"},
+      {"--model itm --tx 45.5,6.5,30 --refractivity 200" + dem + out, "--refractivity 200: must be within [250, 400] N-units"},
+      {"--model itm --tx 45.5,6.5,30 --polarization circular" + dem + out, "--polarization circular: must be horizontal or vertical"},
+      {"--model itm --tx 45.5,6.5,30 --mdvar 5" + dem + out, "--mdvar 5: must be 0..3"},
+      {"--model itm --tx 45.5,6.5,30 --k-factor 1.2" + dem + out, "--k-factor: only with --model deygout"},
+      {"--tx 45.5,6.5,30 --climate 5" + dem + out, "--climate: only with --model itm"},
       {"--tx 45.5,6.5,30 --dem " + (dir.path() / "N00E000.hgt").string() + out, (dir.path() / "N00E000.hgt").string()},
   };
   for (const auto& [args, prefix] : cases) {

@@ -1,0 +1,1015 @@
+// The ITS Irregular Terrain Model, point-to-point mode (itm.h).
+//
+// Sources. G. A. Hufford, "The ITS Irregular Terrain Model, version 1.2.2: the Algorithm"
+// (NTIA/ITS, 1995), "the Algorithm" below, with its equation numbers in parentheses; NTIA Report
+// 82-100 (Hufford, Longley and Kissick 1982) for the parameters, their ranges and the climate
+// curves. The Algorithm was written down by Hufford as the description of the ITM's Fortran
+// version 1.2.2, so where it is terse the behaviour of that version is meant; NTIA's published
+// point-to-point cases (tests/volume/data/ntia_itm_p2p.txt) check the whole chain.
+//
+// The chain, per path (ItmPath::loss):
+//  1. General preparation (the Algorithm, "preparatory calculations"): wave number
+//     k = f / 47.7 MHz m; surface refractivity N_s = N_0 exp(-z_s / 9460 m) with z_s the mean
+//     elevation of the middle 80% of the profile; effective Earth curvature
+//     gamma_e = gamma_a (1 - 0.04665 exp(N_s / 179.3 N-units)), gamma_a = 157e-9 / m; ground
+//     transfer impedance Z_g = sqrt(eps' - 1) (horizontal) or sqrt(eps' - 1) / eps'
+//     (vertical), eps' = eps_r + i Z_0 sigma / k, Z_0 = 376.62 ohm.
+//  2. Point-to-point preparation: each terminal's horizon (the profile sample of steepest
+//     elevation angle, on an Earth of curvature gamma_e; the other terminal if none rises
+//     above the line between them); the terrain irregularity Delta h over the profile less
+//     min(15 h_g, 0.1 d_L) at each end: the interdecile range of the heights about their
+//     least-squares line, resampled at 10 k_a - 5 points (k_a = 0.1 (samples + 8), within
+//     4..25), divided by 1 - 0.8 exp(-d / 50 km); effective heights from least-squares lines:
+//     for a line-of-sight or nearly line-of-sight path (d_L1 + d_L2 > 1.5 d) one line over that
+//     same stretch, with the horizons and their angles then re-derived from the effective
+//     heights as on smooth ground; otherwise one line over each terminal's foreground up to
+//     0.9 of its horizon distance, the horizons staying those of the profile.
+//  3. The reference attenuation A_ref (the Algorithm, "the reference attenuation"): a
+//     straight line through the diffraction attenuation (4.11) at two distances beyond the
+//     smooth-Earth horizon -- a weighted mean of double knife edge (F(v), 4.21, 6.1) and
+//     smooth-Earth (three radii, height-gain 4.20, 6.2-6.7) losses, plus the clutter factor
+//     A_fo; before the smooth-Earth horizon distance d_Ls, A_el + k_1 d + k_2 ln d through the
+//     line-of-sight attenuation (4.44, two rays over rough ground) at two distances and the
+//     diffraction line at d_Ls; far beyond the horizons, the troposcatter line (frequency gain
+//     H_0, 6.13) where it falls below the diffraction line.
+//  4. Variability (the Algorithm, "statistics"): the climate's median adjustment V(d_e) and
+//     the time, location and situation deviations combined as MDVAR says; small attenuations
+//     below zero are compressed, A (29 - A) / (29 - 10 A).
+//  Basic transmission loss = 32.45 + 20 log10(f / MHz) + 20 log10(d / km) + A.
+//
+// Where this departs from a plain transcription, it is for speed and gives the same values (to
+// rounding): the transmitter's steepest interior sample is found once per profile, the
+// receiver's from an upper envelope of its horizon lines built once per profile; least-squares
+// lines over the profile come from prefix sums; Delta h is kept while its window does not
+// change, and its quantiles are searched first among the values near the last ones found;
+// troposcatter is evaluated only for paths long enough that it could matter (beyond
+// max(d_Ls, d_L + 0.3 X_ae ln(47.7 k)), the least the crossover distance can be). One change
+// of substance, at rounding level: positions and counts within 1e-9 of a whole number are taken
+// as that number before the Algorithm rounds them (snap()), so that a path and its reverse
+// give the same loss; otherwise a window end at 0.9 of a horizon distance of ten samples falls
+// on either side of a sample depending on the direction of computation.
+//
+// Limits: the model's own (20 MHz - 20 GHz; paths of 1 - 2000 km; antennas 0.5 - 3000 m; it
+// reports "warning" 3 or 4 outside them, and still gives a number); a single profile stands
+// for the whole path (no clutter, buildings or trees beyond A_fo's statistical allowance); the
+// statistics are those of the Algorithm's climate curves, fitted to measurements of the 1960s.
+#include "volume/itm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace terravol::volume {
+
+namespace {
+
+using Complex = std::complex<double>;
+
+constexpr double kGammaA = 157e-9;  // the Earth's actual curvature, 1/m
+constexpr double kZ0 = 376.62;      // the Algorithm's impedance of free space, ohm
+
+std::string num(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+// The climate curves (NTIA Report 82-100; the Algorithm, "statistics"): for each curve
+// C(d_e) = (c1 + c2 / (1 + ((d_e - x2) / x3)^2)) (d_e / x1)^2 / (1 + (d_e / x1)^2), the
+// median adjustment V and the deviations sigma_T- and sigma_T+ below and above the median;
+// sigma_T+ beyond z_D is sigma_TD = s_d sigma_T+ plus a tail; frequency factors g = f1 + f2 /
+// ((f3 ln(0.133 k))^2 + 1) for below and above the median.
+struct Curve {
+  double c1, c2, x1, x2, x3;
+  double operator()(double de) const {
+    const double a = (de - x2) / x3, b = de / x1;
+    return (c1 + c2 / (1.0 + a * a)) * (b * b) / (1.0 + b * b);
+  }
+};
+struct FrequencyFactor {
+  double f1, f2, f3;
+  double operator()(double ln_k) const {
+    const double a = f3 * ln_k;
+    return f1 + f2 / (a * a + 1.0);
+  }
+};
+struct Climate {
+  Curve median, sigma_minus, sigma_plus;
+  double sd, zd;
+  FrequencyFactor g_minus, g_plus;
+};
+constexpr Climate kClimates[7] = {
+    // 1 equatorial
+    {{-9.67, 12.7, 144.9e3, 190.3e3, 133.8e3}, {2.13, 159.5, 762.2e3, 123.6e3, 94.5e3},
+     {2.11, 102.3, 636.9e3, 134.8e3, 95.6e3}, 1.224, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
+    // 2 continental subtropical
+    {{-0.62, 9.19, 228.9e3, 205.2e3, 143.6e3}, {2.66, 7.67, 100.4e3, 172.5e3, 136.4e3},
+     {6.87, 15.53, 138.7e3, 143.7e3, 98.6e3}, 0.801, 2.161, {1.0, 0.0, 0.0}, {0.93, 0.31, 2.00}},
+    // 3 maritime subtropical
+    {{1.26, 15.5, 262.6e3, 185.2e3, 99.8e3}, {6.11, 6.65, 138.2e3, 242.2e3, 178.6e3},
+     {10.08, 9.60, 165.3e3, 225.7e3, 129.7e3}, 1.380, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
+    // 4 desert
+    {{-9.21, 9.05, 84.1e3, 101.1e3, 98.6e3}, {1.98, 13.11, 139.1e3, 132.7e3, 193.5e3},
+     {3.68, 159.3, 464.4e3, 93.1e3, 94.2e3}, 1.000, 20.0, {1.0, 0.0, 0.0}, {0.93, 0.19, 1.79}},
+    // 5 continental temperate
+    {{-0.62, 9.19, 228.9e3, 205.2e3, 143.6e3}, {2.68, 7.16, 93.7e3, 186.8e3, 133.5e3},
+     {4.75, 8.12, 93.2e3, 135.9e3, 113.4e3}, 1.224, 1.282, {0.92, 0.25, 1.77}, {0.93, 0.31, 2.00}},
+    // 6 maritime temperate, over land
+    {{-0.39, 2.86, 141.7e3, 315.9e3, 167.4e3}, {6.86, 10.38, 187.8e3, 169.6e3, 108.9e3},
+     {8.58, 13.97, 216.0e3, 152.0e3, 122.7e3}, 1.518, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
+    // 7 maritime temperate, over sea
+    {{3.15, 857.9, 2222.0e3, 164.8e3, 116.3e3}, {8.51, 169.8, 609.8e3, 119.9e3, 106.6e3},
+     {8.43, 8.19, 136.2e3, 188.5e3, 122.9e3}, 1.518, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
+};
+
+using itm_detail::TerminalTerms;
+
+// What the preparatory stage hands to the reference attenuation: the path length, the
+// antennas' structural and effective heights, the horizon distances and elevation angles, and
+// the terrain irregularity. Index 0 is the transmitter.
+struct Geometry {
+  double dist = 0.0;
+  double hg[2] = {0, 0}, he[2] = {0, 0}, dl[2] = {0, 0}, the[2] = {0, 0};
+  double dh = 0.0;
+  TerminalTerms terms[2];
+};
+
+struct Medium {
+  double wn = 0.0, ens = 0.0, gme = 0.0;
+  Complex zg;
+  double inverse_abs_zg = 0.0;  // 1 / |Z_g|
+  double xae = 0.0;             // (k gamma_e^2)^(-1/3)
+};
+
+// What the statistics take from the frequency and the climate alone.
+struct Statistics {
+  const Climate* climate = nullptr;
+  double g_minus = 0.0, g_plus = 0.0;  // the frequency factors
+  double dexa_frequency_m = 0.0;       // the frequency's part of d_e's scale, (575.7e12 / k)^(1/3)
+};
+
+// The cube root of x > 0, to the last bit or two (relative error under 1e-15): an estimate
+// from the exponent bits refined by two Halley steps and one Newton step. Written here
+// because the C library's cbrt was the model's most expensive function (four per point).
+double cube_root(double x) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = bits / 3 + 0x2A9F7893782DA1CEull;
+  double y = 0.0;
+  std::memcpy(&y, &bits, sizeof y);
+  for (int k = 0; k < 2; ++k) {
+    const double y3 = y * y * y;
+    y = y * (y3 + 2.0 * x) / (2.0 * y3 + x);
+  }
+  return y - (y * y * y - x) / (3.0 * y * y);
+}
+
+// Delta h(d) = (1 - 0.8 exp(-d / 50 km)) Delta h: the irregularity seen over a distance d.
+double delta_h_over(double d, double dh) { return (1.0 - 0.8 * std::exp(-d / 50e3)) * dh; }
+
+// sigma_h(Delta h) = 0.78 Delta h exp(-(Delta h / 16 m)^(1/4)): the rms deviation of the
+// terrain within the first Fresnel zones, from the irregularity.
+double sigma_h(double dh) { return 0.78 * dh * std::exp(-std::sqrt(std::sqrt(dh / 16.0))); }
+
+// A line fitted by least squares, with the trapezoidal rule's weights (half at both ends), to
+// samples ja..jb (unit spacing) given their sums: the Algorithm's fit of a line to a profile.
+struct Line {
+  double mean = 0.0, slope = 0.0, centre = 0.0;
+  double at(double i) const { return mean + slope * (i - centre); }
+};
+Line trapezoid_fit(double sum_z, double sum_iz, double z_first, double z_last, int ja, int jb) {
+  Line line;
+  const double length = jb - ja;
+  line.centre = 0.5 * (ja + jb);
+  const double moment0 = sum_z - 0.5 * (z_first + z_last);
+  const double moment1 = (sum_iz - line.centre * sum_z) -
+                         0.5 * ((ja - line.centre) * z_first + (jb - line.centre) * z_last);
+  line.mean = moment0 / length;
+  line.slope = 12.0 * moment1 / (length * (length * length + 2.0));
+  return line;
+}
+
+// x with rounding noise around whole numbers removed. The Algorithm rounds sample positions
+// and counts down to whole numbers, and they fall exactly on whole numbers often (a window's
+// end at 0.9 or 0.1 of a horizon distance that is a multiple of ten samples): which way they
+// go must not depend on the direction the path was computed in.
+double snap(double x) {
+  const double r = std::round(x);
+  return std::abs(x - r) < 1e-9 * std::max(1.0, std::abs(x)) ? r : x;
+}
+double in_samples(double x, double xi) { return snap(x / xi); }
+
+// The samples a fit between x1 and x2 (metres) uses: from the one at or before x1 to the one
+// at or after x2, clipped to the profile, widened by one each side when that leaves fewer
+// than two.
+void fit_window(double x1, double x2, double xi, int n, int& ja, int& jb) {
+  double a = std::floor(std::max(in_samples(x1, xi), 0.0));
+  double b = n - std::floor(std::max(n - in_samples(x2, xi), 0.0));
+  if (b <= a) {
+    a = std::max(a - 1.0, 0.0);
+    b = n - std::max(n - (b + 1.0), 0.0);
+  }
+  ja = static_cast<int>(a);
+  jb = static_cast<int>(b);
+}
+
+// The k-th smallest (0-based; kLargest: the k-th largest) of c[0..count), count > k,
+// reordering c. With few values beyond it, by taking the extreme off count - 1 - k times
+// (branch-free passes over a few dozen values); else std::nth_element.
+template <bool kLargest>
+double kth_extreme(double* c, std::size_t count, std::size_t k) {
+  std::size_t beyond = count - 1 - k;
+  if (beyond > 8) {
+    if constexpr (kLargest) {
+      std::nth_element(c, c + k, c + count, std::greater<double>());
+    } else {
+      std::nth_element(c, c + k, c + count);
+    }
+    return c[k];
+  }
+  auto extreme = [](double a, double b) { return kLargest ? std::min(a, b) : std::max(a, b); };
+  for (;;) {
+    // Two running extremes (exact in any order), then the first place of it.
+    double top = c[0], top2 = c[count - 1];
+    for (std::size_t i = 1; i + 1 < count; i += 2) {
+      top = extreme(top, c[i]);
+      top2 = extreme(top2, c[i + 1]);
+    }
+    top = extreme(top, top2);
+    if (beyond == 0) return top;
+    std::size_t at = 0;
+    while (c[at] != top) ++at;
+    c[at] = c[--count];
+    --beyond;
+  }
+}
+
+double delta_h_of(const double* z, int np, double xi, double x1, double x2, DeltaHScratch& w) {
+  const double xa = in_samples(x1, xi), xb = in_samples(x2, xi);
+  const double span = snap(xb - xa);
+  if (span < 2.0) return 0.0;
+  const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
+  const int n = 10 * ka - 5;
+  const auto size = static_cast<std::size_t>(n);
+  w.samples.resize(size);
+  w.low.resize(size);
+  w.high.resize(size);
+  double* s = w.samples.data();
+  // Linear interpolation at n equally spaced points p from xa to xb, each on the interval that
+  // ends at sample k = ceil(p), within [floor(xa) + 1, np] (p >= 0 here, so ceil(p) is the
+  // truncation plus one unless p is whole); the sums for the line, in order.
+  const double step = (xb - xa) / (n - 1);
+  const int k0 = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
+  double sum = 0.0, sum_i = 0.0, jd = 0.0;
+  int j = 0;
+#if defined(__SSE2__)
+  // Two points at a time, with the same operations as the scalar loop below.
+  {
+    const __m128d xa2 = _mm_set1_pd(xa), step2 = _mm_set1_pd(step), one = _mm_set1_pd(1.0);
+    const __m128d two = _mm_set1_pd(2.0), lo = _mm_set1_pd(k0), hi = _mm_set1_pd(np);
+    __m128d j2 = _mm_set_pd(1.0, 0.0);
+    for (; j + 1 < n; j += 2, j2 = _mm_add_pd(j2, two)) {
+      const __m128d p = _mm_add_pd(xa2, _mm_mul_pd(j2, step2));
+      __m128d k = _mm_cvtepi32_pd(_mm_cvttpd_epi32(p));
+      k = _mm_add_pd(k, _mm_and_pd(_mm_cmplt_pd(k, p), one));
+      k = _mm_min_pd(hi, _mm_max_pd(lo, k));
+      const __m128i ki = _mm_cvttpd_epi32(k);
+      const int ka0 = _mm_cvtsi128_si32(ki), ka1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(ki, 1));
+      const __m128d zk = _mm_loadh_pd(_mm_load_sd(z + ka0), z + ka1);
+      const __m128d zm = _mm_loadh_pd(_mm_load_sd(z + ka0 - 1), z + ka1 - 1);
+      const __m128d v = _mm_add_pd(zk, _mm_mul_pd(_mm_sub_pd(zk, zm), _mm_sub_pd(p, k)));
+      _mm_storeu_pd(s + j, v);
+      const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
+      sum += v0;
+      sum_i += jd * v0;
+      jd += 1.0;
+      sum += v1;
+      sum_i += jd * v1;
+      jd += 1.0;
+    }
+  }
+#endif
+  for (; j < n; ++j, jd += 1.0) {
+    const double p = xa + j * step;
+    int k = static_cast<int>(p);
+    k += k < p ? 1 : 0;
+    k = std::min(np, std::max(k0, k));
+    const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
+    s[j] = v;
+    sum += v;
+    sum_i += jd * v;
+  }
+  const Line line = trapezoid_fit(sum, sum_i, s[0], s[n - 1], 0, n - 1);
+  const double at0 = line.at(0.0), slope = line.slope;
+  // The ka-th smallest and the ka-th largest deviation from the line. Their candidates are
+  // gathered in the same pass: the deviations beyond thresholds a little inside the last ones
+  // found; when too few, again with thresholds 4, 16 and 64 times farther in, then all. Exact
+  // whatever the guess: it only decides how much is gathered. Deviation i is
+  // s[i] - (at0 + slope i), computed alike wherever it is needed.
+  const auto rank = static_cast<std::size_t>(ka - 1);
+  const bool guessed = std::isfinite(w.lower) && std::isfinite(w.upper) && w.upper > w.lower;
+  const double margin = guessed ? 0.02 * (w.upper - w.lower) : 0.0;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double* low = w.low.data();
+  double* high = w.high.data();
+  std::size_t n_low = 0, n_high = 0;
+  if (guessed) {
+    const double low_threshold = w.lower + margin, high_threshold = w.upper - margin;
+    int i = 0;
+#if defined(__SSE2__)
+    {
+      const __m128d at2 = _mm_set1_pd(at0), slope2 = _mm_set1_pd(slope), two = _mm_set1_pd(2.0);
+      const __m128d lt = _mm_set1_pd(low_threshold), ht = _mm_set1_pd(high_threshold);
+      __m128d i2 = _mm_set_pd(1.0, 0.0);
+      for (; i + 1 < n; i += 2, i2 = _mm_add_pd(i2, two)) {
+        const __m128d r = _mm_sub_pd(_mm_loadu_pd(s + i), _mm_add_pd(at2, _mm_mul_pd(slope2, i2)));
+        const int below = _mm_movemask_pd(_mm_cmple_pd(r, lt)), above = _mm_movemask_pd(_mm_cmpge_pd(r, ht));
+        const double r0 = _mm_cvtsd_f64(r), r1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
+        low[n_low] = r0;
+        n_low += static_cast<std::size_t>(below & 1);
+        low[n_low] = r1;
+        n_low += static_cast<std::size_t>(below >> 1);
+        high[n_high] = r0;
+        n_high += static_cast<std::size_t>(above & 1);
+        high[n_high] = r1;
+        n_high += static_cast<std::size_t>(above >> 1);
+      }
+    }
+#endif
+    for (double id = i; i < n; ++i, id += 1.0) {
+      const double r = s[i] - (at0 + slope * id);
+      low[n_low] = r;
+      n_low += r <= low_threshold ? 1 : 0;
+      high[n_high] = r;
+      n_high += r >= high_threshold ? 1 : 0;
+    }
+  }
+  // One side again, below threshold (sign 1) or above it (sign -1); everything when not finite.
+  auto regather = [&](double* c, double sign, double threshold) {
+    std::size_t count = 0;
+    double id = 0.0;
+    for (int i = 0; i < n; ++i, id += 1.0) {
+      const double r = s[i] - (at0 + slope * id);
+      c[count] = r;
+      count += sign * r <= sign * threshold ? 1 : 0;
+    }
+    return count;
+  };
+  for (double widen = 4.0; widen <= 64.0 && guessed; widen *= 4.0) {
+    if (n_low <= rank) n_low = regather(low, 1.0, w.lower + widen * margin);
+    if (n_high <= rank) n_high = regather(high, -1.0, w.upper - widen * margin);
+  }
+  if (n_low <= rank) n_low = regather(low, 1.0, kInf);
+  if (n_high <= rank) n_high = regather(high, -1.0, -kInf);
+  const double lower = kth_extreme<false>(low, n_low, rank);
+  const double upper = kth_extreme<true>(high, n_high, rank);
+  w.lower = lower;
+  w.upper = upper;
+  return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
+}
+
+TerminalTerms terminal_terms(double dl, double he, const Medium& m) {
+  TerminalTerms t;
+  t.dls = std::sqrt(2.0 * he / m.gme);
+  const double a = 0.5 * dl * dl / he;  // the horizon's radius
+  const double wa = cube_root(a * m.wn);
+  const double pk = m.inverse_abs_zg / wa;
+  t.x = (1.607 - pk) * 151.0 * wa * dl / a;
+  t.gain_db = itm_functions::height_gain_db(t.x, pk);
+  t.dexa = std::sqrt(18e6 * he);
+  return t;
+}
+
+// The diffraction attenuation A_diff(d) (4.11) for one geometry: with the weight w, the
+// rounded-Earth (three radii) value A_r and the double knife edge A_k, w A_r + (1 - w) A_k + A_fo.
+class Diffraction {
+ public:
+  Diffraction(const Geometry& g, const Medium& m, double dlsa, double dla, double tha)
+      : g_(g), wn_(m.wn), gme_(m.gme), dla_(dla), tha_(tha) {
+    const double hgg = g.hg[0] * g.hg[1];
+    // The point-to-point mode adds 10 m^2 to the product of the structural heights.
+    wd1_ = std::sqrt(1.0 + (g.he[0] * g.he[1] - hgg) / (hgg + 10.0));
+    xd1_ = dla + tha / m.gme;
+    afo_ = std::min(15.0, 2.171 * std::log(1.0 + 4.77e-4 * hgg * m.wn * sigma_h(delta_h_over(dlsa, g.dh))));
+    qk_ = m.inverse_abs_zg;
+    for (const TerminalTerms& t : g.terms) {
+      xht_ += t.x;
+      aht_ += t.gain_db;
+    }
+  }
+
+  double at(double d) const {
+    const double th = tha_ + d * gme_;
+    const double ds = d - dla_;
+    const double v2 = 0.0795775 * wn_ * ds * th * th;  // 1 / (4 pi)
+    const double knife = itm_functions::knife_edge_db(v2 * g_.dl[0] / (ds + g_.dl[0])) +
+                         itm_functions::knife_edge_db(v2 * g_.dl[1] / (ds + g_.dl[1]));
+    const double a = ds / th;
+    const double wa = cube_root(a * wn_);
+    const double pk = qk_ / wa;
+    const double x = (1.607 - pk) * 151.0 * wa * th + xht_;
+    const double rounded = 0.05751 * x - 4.343 * std::log(x) - aht_;
+    const double q = (wd1_ + xd1_ / d) * std::min(delta_h_over(d, g_.dh) * wn_, 6283.2);
+    const double w = 25.1 / (25.1 + std::sqrt(q));
+    return rounded * w + (1.0 - w) * knife + afo_;
+  }
+
+ private:
+  const Geometry& g_;
+  double wn_, gme_, dla_, tha_;
+  double wd1_ = 0.0, xd1_ = 0.0, afo_ = 0.0, qk_ = 0.0, aht_ = 20.0, xht_ = 0.0;
+};
+
+// The line-of-sight attenuation A_los(d) (4.44): the two-ray field over rough ground, with the
+// reflection coefficient reduced by the terrain's roughness, mixed with the extended
+// diffraction line A_ed + m_d d by the weight w.
+class LineOfSight {
+ public:
+  LineOfSight(const Geometry& g, const Medium& m, double emd, double aed, double dlsa)
+      : g_(g), m_(m), emd_(emd), aed_(aed), wls_(0.021 / (0.021 + m.wn * g.dh / std::max(10e3, dlsa))) {}
+
+  double at(double d) const {
+    const double sh = sigma_h(delta_h_over(d, g_.dh));
+    const double hsum = g_.he[0] + g_.he[1];
+    const double sin_psi = hsum / std::sqrt(d * d + hsum * hsum);
+    // R = (sin psi - Z_g) / (sin psi + Z_g) exp(-min(10, k sigma_h sin psi)), in real arithmetic.
+    const double zr = m_.zg.real(), zi = m_.zg.imag();
+    const double nr = sin_psi - zr, dr = sin_psi + zr;  // numerator -i zi, denominator +i zi
+    const double scale = std::exp(-std::min(10.0, m_.wn * sh * sin_psi)) / (dr * dr + zi * zi);
+    double rr = (nr * dr - zi * zi) * scale, ri = (-zi * dr - nr * zi) * scale;
+    const double r2 = rr * rr + ri * ri;
+    if (r2 < 0.25 || r2 < sin_psi) {
+      const double f = std::sqrt(sin_psi / r2);
+      rr *= f;
+      ri *= f;
+    }
+    const double extended = emd_ * d + aed_;
+    double delta = 2.0 * m_.wn * g_.he[0] * g_.he[1] / d;  // the rays' phase difference
+    if (delta > 1.57) delta = 3.14 - 2.4649 / delta;
+    const double sum_r = std::cos(delta) + rr, sum_i = -std::sin(delta) + ri;
+    const double two_ray = -4.343 * std::log(sum_r * sum_r + sum_i * sum_i);
+    return (two_ray - extended) * wls_ + extended;
+  }
+
+ private:
+  const Geometry& g_;
+  const Medium& m_;
+  double emd_, aed_, wls_;
+};
+
+// The troposcatter attenuation A_scat(d). Its frequency gain H_0 carries from one evaluation to
+// the next (the Algorithm keeps the previous value when the new one would exceed 15 dB), so
+// the order of evaluation is the Algorithm's: the farther distance first.
+class Troposcatter {
+ public:
+  Troposcatter(const Geometry& g, const Medium& m, double tha) : g_(g), m_(m), tha_(tha) {
+    ad_ = g.dl[0] - g.dl[1];
+    rr_ = g.he[1] / g.he[0];
+    if (ad_ < 0.0) {
+      ad_ = -ad_;
+      rr_ = 1.0 / rr_;
+    }
+    etq_ = (5.67e-6 * m.ens - 2.32e-3) * m.ens + 0.031;
+  }
+
+  // 1001 dB (no scatter) when both antennas are too low for it.
+  double at(double d) {
+    double h0 = h0s_;
+    if (h0s_ <= 15.0) {
+      const double th = g_.the[0] + g_.the[1] + d * m_.gme;
+      const double r1 = 2.0 * m_.wn * th * g_.he[0], r2 = 2.0 * m_.wn * th * g_.he[1];
+      if (r1 < 0.2 && r2 < 0.2) return 1001.0;
+      double ss = (d - ad_) / (d + ad_);
+      const double q = std::min(std::max(0.1, rr_ / ss), 10.0);
+      ss = std::max(0.1, ss);
+      const double z0 = (d - ad_) * (d + ad_) * th * 0.25 / d;  // height of the crossing rays
+      const double et = (etq_ * std::exp(-std::pow(std::min(1.7, z0 / 8.0e3), 6.0)) + 1.0) * z0 / 1.7556e3;
+      const double ett = std::max(et, 1.0);
+      h0 = 0.5 * (itm_functions::frequency_gain_db(r1, ett) + itm_functions::frequency_gain_db(r2, ett));
+      h0 += std::min(h0, (1.38 - std::log(ett)) * std::log(ss) * std::log(q) * 0.49);
+      h0 = std::max(h0, 0.0);
+      if (et < 1.0) {
+        const double f = (1.0 + 1.4142 / r1) * (1.0 + 1.4142 / r2);
+        h0 = et * h0 + (1.0 - et) * 4.343 * std::log(f * f * (r1 + r2) / (r1 + r2 + 2.8284));
+      }
+      if (h0 > 15.0 && h0s_ >= 0.0) h0 = h0s_;
+    }
+    h0s_ = h0;
+    const double th = tha_ + d * m_.gme;
+    return itm_functions::scatter_f_db(th * d) + 4.343 * std::log(47.7 * m_.wn * th * th * th * th) -
+           0.1 * (m_.ens - 301.0) * std::exp(-th * d / 40e3) + h0;
+  }
+
+ private:
+  const Geometry& g_;
+  const Medium& m_;
+  double tha_, ad_ = 0.0, rr_ = 0.0, etq_ = 0.0, h0s_ = -15.0;
+};
+
+struct Reference {
+  double aref = 0.0;
+  ItmMode mode = ItmMode::kLineOfSight;
+  int warning = 0;
+};
+
+// The reference attenuation of the Algorithm's point-to-point mode at the path's own length.
+Reference reference_attenuation(const Geometry& g, const Medium& m) {
+  Reference out;
+  int& w = out.warning;
+  const double dls[2] = {g.terms[0].dls, g.terms[1].dls};  // smooth-Earth horizons
+  const double dlsa = dls[0] + dls[1], dla = g.dl[0] + g.dl[1];
+  const double tha = std::max(g.the[0] + g.the[1], -dla * m.gme);
+
+  // The Algorithm's range checks.
+  if (m.wn < 0.838 || m.wn > 210.0) w = std::max(w, 1);
+  for (int j = 0; j < 2; ++j) {
+    if (g.hg[j] < 1.0 || g.hg[j] > 1000.0) w = std::max(w, 1);
+    if (std::abs(g.the[j]) > 200e-3 || g.dl[j] < 0.1 * dls[j] || g.dl[j] > 3.0 * dls[j]) w = std::max(w, 3);
+  }
+  if (m.ens < 250.0 || m.ens > 400.0 || m.gme < 75e-9 || m.gme > 250e-9 || m.zg.real() <= std::abs(m.zg.imag()) ||
+      m.wn < 0.419 || m.wn > 420.0 || g.hg[0] < 0.5 || g.hg[0] > 3000.0 || g.hg[1] < 0.5 || g.hg[1] > 3000.0) {
+    w = 4;
+  }
+  if (g.dist > 1000e3) w = std::max(w, 1);
+  if (g.dist < std::abs(g.he[0] - g.he[1]) / 200e-3) w = std::max(w, 3);
+  if (g.dist < 1e3 || g.dist > 2000e3) w = 4;
+
+  // The diffraction line through two distances beyond the smooth-Earth horizons.
+  const Diffraction diffraction(g, m, dlsa, dla, tha);
+  const double xae = m.xae;
+  const double d3 = std::max(dlsa, 1.3787 * xae + dla), d4 = d3 + 2.7574 * xae;
+  const double a3 = diffraction.at(d3), a4 = diffraction.at(d4);
+  const double emd = (a4 - a3) / (d4 - d3), aed = a3 - emd * d3;
+
+  const double d = g.dist;
+  if (d < dlsa) {
+    // Line of sight: A_el + k_1 d + k_2 ln d through A_los at d0 and d1 and the diffraction
+    // line at d2 = d_Ls, with k_1, k_2 >= 0.
+    const LineOfSight los(g, m, emd, aed, dlsa);
+    const double d2 = dlsa, a2 = aed + d2 * emd;
+    double d0 = 1.908 * m.wn * g.he[0] * g.he[1], d1;
+    if (aed >= 0.0) {
+      d0 = std::min(d0, 0.5 * dla);
+      d1 = d0 + 0.25 * (dla - d0);
+    } else {
+      d1 = std::max(-aed / emd, 0.25 * dla);
+    }
+    const double a1 = los.at(d1);
+    double ak1 = 0.0, ak2 = 0.0;
+    bool fitted = false;
+    const double ln_d2 = std::log(d2);
+    if (d0 < d1) {
+      const double a0 = los.at(d0);
+      const double ln_d0 = std::log(d0);
+      const double q = ln_d2 - ln_d0;  // ln(d2 / d0)
+      ak2 = std::max(0.0, ((d2 - d0) * (a1 - a0) - (d1 - d0) * (a2 - a0)) / ((d2 - d0) * (std::log(d1) - ln_d0) - (d1 - d0) * q));
+      fitted = aed >= 0.0 || ak2 > 0.0;
+      if (fitted) {
+        ak1 = (a2 - a0 - ak2 * q) / (d2 - d0);
+        if (ak1 < 0.0) {
+          ak1 = 0.0;
+          ak2 = std::max(a2 - a0, 0.0) / q;
+          if (ak2 == 0.0) ak1 = emd;
+        }
+      }
+    }
+    if (!fitted) {
+      ak1 = std::max(a2 - a1, 0.0) / (d2 - d1);
+      ak2 = 0.0;
+      if (ak1 == 0.0) ak1 = emd;
+    }
+    const double ael = a2 - ak1 * d2 - ak2 * ln_d2;
+    out.aref = ael + ak1 * d + (ak2 != 0.0 ? ak2 * std::log(d) : 0.0);
+    out.mode = ItmMode::kLineOfSight;
+  } else {
+    // Beyond: the diffraction line, or the troposcatter line beyond the distance d_x where it
+    // crosses below. d_x is at least dx_floor, so shorter paths need no scatter at all.
+    const double dx_floor = std::max(dlsa, dla + 0.3 * xae * std::log(47.7 * m.wn));
+    double dx = dx_floor, ems = emd, aes = aed;
+    if (d > dx_floor) {
+      Troposcatter scatter(g, m, tha);
+      const double d5 = dla + 200e3, d6 = d5 + 200e3;
+      const double a6 = scatter.at(d6);
+      const double a5 = scatter.at(d5);
+      if (a5 < 1000.0) {
+        ems = (a6 - a5) / 200e3;
+        dx = std::max(dx_floor, (a5 - aed - ems * d5) / (emd - ems));
+        aes = (emd - ems) * dx + aed;
+      } else {
+        dx = 10e6;
+      }
+    }
+    if (d > dx) {
+      out.aref = aes + ems * d;
+      out.mode = ItmMode::kTroposcatter;
+    } else {
+      out.aref = aed + emd * d;
+      out.mode = ItmMode::kDiffraction;
+    }
+  }
+  out.aref = std::max(out.aref, 0.0);
+  return out;
+}
+
+// The requested quantile of attenuation (the Algorithm, "statistics").
+double variability(double aref, const Geometry& g, const Medium& m, const Statistics& st, const ItmParameters& p,
+                   double zt, double zl, double zc, int& warning) {
+  const Climate& c = *st.climate;
+  const double gm = st.g_minus, gp = st.g_plus;
+  // The effective distance d_e: 130 km at the sum of the smooth-Earth horizons plus a
+  // frequency term, proportional before it and growing one for one after.
+  const double dexa = g.terms[0].dexa + g.terms[1].dexa + st.dexa_frequency_m;
+  const double de = g.dist < dexa ? 130e3 * g.dist / dexa : 130e3 + g.dist - dexa;
+  const double vmd = c.median(de);
+  const double sgtm = c.sigma_minus(de) * gm, sgtp = c.sigma_plus(de) * gp;
+  const double sgtd = sgtp * c.sd, tgtd = (sgtp - sgtd) * c.zd;
+  double sgl = 0.0;
+  if (p.location_variability) {
+    const double q = delta_h_over(g.dist, g.dh) * m.wn;
+    sgl = 10.0 * q / (q + 13.0);
+  }
+  double vs0 = 0.0;
+  if (p.situation_variability) {
+    const double a = 5.0 + 3.0 * std::exp(-de / 100e3);
+    vs0 = a * a;
+  }
+  switch (p.variability) {
+    case ItmVariability::kSingleMessage: zt = zl = zc; break;
+    case ItmVariability::kAccidental: zl = zc; break;
+    case ItmVariability::kMobile: zl = zt; break;
+    case ItmVariability::kBroadcast: break;
+  }
+  if (std::abs(zt) > 3.1 || std::abs(zl) > 3.1 || std::abs(zc) > 3.1) warning = std::max(warning, 1);
+  const double sgt = zt < 0.0 ? sgtm : zt <= c.zd ? sgtp : sgtd + tgtd / zt;
+  const double vs = vs0 + (sgt * zt) * (sgt * zt) / (7.8 + zc * zc) + (sgl * zl) * (sgl * zl) / (24.0 + zc * zc);
+  double yr = 0.0, sgc = 0.0;
+  switch (p.variability) {
+    case ItmVariability::kSingleMessage: sgc = std::sqrt(sgt * sgt + sgl * sgl + vs); break;
+    case ItmVariability::kAccidental:
+      yr = sgt * zt;
+      sgc = std::sqrt(sgl * sgl + vs);
+      break;
+    case ItmVariability::kMobile:
+      yr = std::sqrt(sgt * sgt + sgl * sgl) * zt;
+      sgc = std::sqrt(vs);
+      break;
+    case ItmVariability::kBroadcast:
+      yr = sgt * zt + sgl * zl;
+      sgc = std::sqrt(vs);
+      break;
+  }
+  double a = aref - vmd - yr - sgc * zc;
+  if (a < 0.0) a = a * (29.0 - a) / (29.0 - 10.0 * a);
+  return a;
+}
+
+}  // namespace
+
+int ItmParameters::mdvar() const {
+  return static_cast<int>(variability) + (location_variability ? 0 : 10) + (situation_variability ? 0 : 20);
+}
+
+void check_itm(double frequency_mhz, const ItmParameters& p) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("ITM " + what); };
+  auto fraction = [&](const char* name, double v) {
+    if (!(v > 0.0 && v < 1.0)) bad(std::string(name) + " fraction " + num(v) + ": must be within (0, 1)");
+  };
+  if (!(frequency_mhz >= 20.0 && frequency_mhz <= 20000.0)) {
+    bad("frequency " + num(frequency_mhz) + " MHz: must be within [20, 20000] MHz");
+  }
+  if (!(p.permittivity > 1.0 && p.permittivity <= 100.0)) {
+    bad("permittivity " + num(p.permittivity) + ": must be within (1, 100]");
+  }
+  if (!(p.conductivity > 0.0 && p.conductivity <= 100.0)) {
+    bad("conductivity " + num(p.conductivity) + " S/m: must be within (0, 100] S/m");
+  }
+  if (!(p.refractivity >= 250.0 && p.refractivity <= 400.0)) {
+    bad("refractivity " + num(p.refractivity) + " N-units: must be within [250, 400] N-units");
+  }
+  const int climate = static_cast<int>(p.climate);
+  if (climate < 1 || climate > 7) {
+    bad("climate " + std::to_string(climate) + ": must be within 1..7 (1 equatorial ... 7 maritime temperate over sea)");
+  }
+  const int variability = static_cast<int>(p.variability);
+  if (variability < 0 || variability > 3) bad("variability mode " + std::to_string(variability) + ": must be within 0..3");
+  if (p.polarization != ItmPolarization::kHorizontal && p.polarization != ItmPolarization::kVertical) {
+    bad("polarization: must be horizontal or vertical");
+  }
+  fraction("time", p.time);
+  fraction("location", p.location);
+  fraction("situation", p.situation);
+}
+
+std::string itm_climate_name(ItmClimate climate) {
+  switch (climate) {
+    case ItmClimate::kEquatorial: return "equatorial";
+    case ItmClimate::kContinentalSubtropical: return "continental subtropical";
+    case ItmClimate::kMaritimeSubtropical: return "maritime subtropical";
+    case ItmClimate::kDesert: return "desert";
+    case ItmClimate::kContinentalTemperate: return "continental temperate";
+    case ItmClimate::kMaritimeTemperateOverLand: return "maritime temperate over land";
+    case ItmClimate::kMaritimeTemperateOverSea: return "maritime temperate over sea";
+  }
+  return "unknown";
+}
+
+ItmPath::ItmPath(double frequency_mhz, const ItmParameters& parameters)
+    : frequency_mhz_(frequency_mhz), p_(parameters) {
+  check_itm(frequency_mhz, parameters);
+  wn_ = frequency_mhz / 47.7;
+  const Complex eps(parameters.permittivity, kZ0 * parameters.conductivity / wn_);
+  Complex zg = std::sqrt(eps - 1.0);
+  if (parameters.polarization == ItmPolarization::kVertical) zg /= eps;
+  zg_re_ = zg.real();
+  zg_im_ = zg.imag();
+  inverse_abs_zg_ = 1.0 / std::abs(zg);
+  const Climate& climate = kClimates[static_cast<int>(parameters.climate) - 1];
+  const double ln_k = std::log(0.133 * wn_);
+  g_minus_ = climate.g_minus(ln_k);
+  g_plus_ = climate.g_plus(ln_k);
+  dexa_frequency_m_ = std::cbrt(575.7e12 / wn_);
+  z_time_ = itm_functions::inverse_normal(parameters.time);
+  z_location_ = itm_functions::inverse_normal(parameters.location);
+  z_situation_ = itm_functions::inverse_normal(parameters.situation);
+}
+
+void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, double tx_height_m) {
+  if (ground_m.size() < 2) throw std::invalid_argument("ITM profile: needs at least 2 samples");
+  if (!(spacing_m > 0.0) || !std::isfinite(spacing_m)) throw std::invalid_argument("ITM profile spacing " + num(spacing_m) + ": must be > 0");
+  if (!std::isfinite(tx_height_m)) throw std::invalid_argument("ITM transmitter height: not finite");
+  n_ = static_cast<int>(ground_m.size()) - 1;
+  xi_ = spacing_m;
+  dist_ = n_ * xi_;
+  hg_tx_ = tx_height_m;
+  z_.assign(ground_m.begin(), ground_m.end());
+  const auto size = static_cast<std::size_t>(n_) + 2;
+  sum_z_.resize(size);
+  sum_iz_.resize(size);
+  sum_z_[0] = sum_iz_[0] = 0.0;
+  for (int i = 0; i <= n_; ++i) {
+    const double z = z_[static_cast<std::size_t>(i)];
+    if (!std::isfinite(z)) throw std::invalid_argument("ITM profile: sample " + std::to_string(i) + " is not finite");
+    sum_z_[static_cast<std::size_t>(i) + 1] = sum_z_[static_cast<std::size_t>(i)] + z;
+    sum_iz_[static_cast<std::size_t>(i) + 1] = sum_iz_[static_cast<std::size_t>(i)] + i * z;
+  }
+  // N_s and gamma_e from the mean elevation of the middle 80% of the profile.
+  const int p10 = static_cast<int>(0.1 * n_);
+  const double zs = (sum_z_[static_cast<std::size_t>(n_ - p10 + 1)] - sum_z_[static_cast<std::size_t>(p10)]) /
+                    (n_ - 2 * p10 + 1);
+  ns_ = p_.refractivity * std::exp(-zs / 9460.0);
+  free_space_path_db_ = 32.45 + 20.0 * std::log10(frequency_mhz_) + 20.0 * std::log10(dist_ / 1000.0);
+  gme_ = kGammaA * (1.0 - 0.04665 * std::exp(ns_ / 179.3));
+
+  // Horizon terms: elevation angles on the Earth of curvature gamma_e (heights relative to the
+  // terminal, less the drop qc s^2 of the curved Earth, over the distance s).
+  const double qc = 0.5 * gme_;
+  const double za = z_[0] + hg_tx_;
+  tx_best_angle_ = -std::numeric_limits<double>::infinity();
+  tx_best_distance_ = dist_;
+  rx_a_.resize(static_cast<std::size_t>(n_) + 1);
+  rx_u_.resize(static_cast<std::size_t>(n_) + 1);
+  for (int i = 1; i < n_; ++i) {
+    const double z = z_[static_cast<std::size_t>(i)];
+    const double s = i * xi_, sb = dist_ - s;
+    const double angle = (z - za) / s - qc * s;
+    if (angle > tx_best_angle_) {
+      tx_best_angle_ = angle;
+      tx_best_distance_ = s;
+    }
+    rx_a_[static_cast<std::size_t>(i)] = z / sb - qc * sb;
+    rx_u_[static_cast<std::size_t>(i)] = 1.0 / sb;
+  }
+  dh_x1_ = dh_x2_ = -1.0;
+  tx_terms_dl_ = tx_terms_he_ = -1.0;
+  rx_hull_built_ = false;
+  xae_ = std::cbrt(1.0 / (wn_ * gme_ * gme_));
+}
+
+int ItmPath::receiver_horizon(double zb) {
+  // The elevation angle of sample i seen from the receiver at height zb is the line
+  // a_i - u_i zb, u_i = 1 / (distance to it) growing with i; the steepest sample is the upper
+  // envelope of these lines at zb, which moves to smaller i as zb grows. The envelope is built
+  // once per profile (in order of increasing slope -u_i), and successive heights walk along
+  // it.
+  if (!rx_hull_built_) {
+    rx_hull_.clear();
+    for (int i = n_ - 1; i >= 1; --i) {
+      const double a3 = rx_a_[static_cast<std::size_t>(i)], u3 = rx_u_[static_cast<std::size_t>(i)];
+      while (rx_hull_.size() >= 2) {
+        const auto l1 = static_cast<std::size_t>(rx_hull_[rx_hull_.size() - 2]);
+        const auto l2 = static_cast<std::size_t>(rx_hull_.back());
+        // l2 is never above both neighbours when l1 and l3 cross at or before l1 and l2 do.
+        if ((rx_a_[l1] - a3) * (rx_u_[l1] - rx_u_[l2]) <= (rx_a_[l1] - rx_a_[l2]) * (rx_u_[l1] - u3)) {
+          rx_hull_.pop_back();
+        } else {
+          break;
+        }
+      }
+      rx_hull_.push_back(i);
+    }
+    rx_hull_built_ = true;
+    rx_hull_at_ = 0;
+    rx_hull_last_zb_ = -std::numeric_limits<double>::infinity();
+  }
+  if (zb < rx_hull_last_zb_) rx_hull_at_ = 0;
+  rx_hull_last_zb_ = zb;
+  auto value = [&](std::size_t h) {
+    const auto i = static_cast<std::size_t>(rx_hull_[h]);
+    return rx_a_[i] - zb * rx_u_[i];
+  };
+  while (rx_hull_at_ + 1 < rx_hull_.size() && value(rx_hull_at_ + 1) >= value(rx_hull_at_)) ++rx_hull_at_;
+  return rx_hull_[rx_hull_at_];
+}
+
+double ItmPath::delta_h(double x1, double x2) {
+  if (x1 != dh_x1_ || x2 != dh_x2_) {
+    dh_x1_ = x1;
+    dh_x2_ = x2;
+    dh_value_ = delta_h_of(z_.data(), n_, xi_, x1, x2, dh_scratch_);
+  }
+  return dh_value_;
+}
+
+ItmLoss ItmPath::loss(double rx_height_m) {
+  Geometry g;
+  g.dist = dist_;
+  g.hg[0] = hg_tx_;
+  g.hg[1] = rx_height_m;
+  const double za = z_[0] + hg_tx_, zb = z_[static_cast<std::size_t>(n_)] + rx_height_m;
+  const double qc = 0.5 * gme_;
+
+  // The horizons: the other terminal, unless a sample rises above the line between them (then
+  // each terminal's steepest sample; the first of equals from the transmitter).
+  const double chord = (zb - za) / dist_;
+  g.the[0] = chord - qc * dist_;
+  g.the[1] = -chord - qc * dist_;
+  g.dl[0] = g.dl[1] = dist_;
+  if (tx_best_angle_ > g.the[0]) {
+    g.the[0] = tx_best_angle_;
+    g.dl[0] = tx_best_distance_;
+    const int i = receiver_horizon(zb);
+    const double angle = rx_a_[static_cast<std::size_t>(i)] - zb * rx_u_[static_cast<std::size_t>(i)];
+    if (angle > g.the[1]) {
+      g.the[1] = angle;
+      g.dl[1] = dist_ - i * xi_;
+    }
+  }
+
+  // Terrain irregularity between the foregrounds, then the effective heights.
+  const double xl0 = std::min(15.0 * g.hg[0], 0.1 * g.dl[0]);
+  const double xl1 = dist_ - std::min(15.0 * g.hg[1], 0.1 * g.dl[1]);
+  g.dh = delta_h(xl0, xl1);
+  auto fit = [&](double x1, double x2) {
+    int ja = 0, jb = 0;
+    fit_window(x1, x2, xi_, n_, ja, jb);
+    const auto a = static_cast<std::size_t>(ja), b = static_cast<std::size_t>(jb);
+    return trapezoid_fit(sum_z_[b + 1] - sum_z_[a], sum_iz_[b + 1] - sum_iz_[a], z_[a], z_[b], ja, jb);
+  };
+  Medium m;
+  m.wn = wn_;
+  m.ens = ns_;
+  m.gme = gme_;
+  m.zg = Complex(zg_re_, zg_im_);
+  m.inverse_abs_zg = inverse_abs_zg_;
+  m.xae = xae_;
+  // The terminal terms once the horizon distances and effective heights are final; the
+  // transmitter's from the last receiver's when those are the same.
+  auto set_terms = [&] {
+    if (g.dl[0] != tx_terms_dl_ || g.he[0] != tx_terms_he_) {
+      tx_terms_ = terminal_terms(g.dl[0], g.he[0], m);
+      tx_terms_dl_ = g.dl[0];
+      tx_terms_he_ = g.he[0];
+    }
+    g.terms[0] = tx_terms_;
+    g.terms[1] = terminal_terms(g.dl[1], g.he[1], m);
+  };
+  auto horizon = [&](double he) { return std::sqrt(2.0 * he / gme_) * std::exp(-0.07 * std::sqrt(g.dh / std::max(he, 5.0))); };
+  const double z_first = z_[0], z_last = z_[static_cast<std::size_t>(n_)];
+  if (g.dl[0] + g.dl[1] > 1.5 * dist_) {
+    const Line line = fit(xl0, xl1);
+    g.he[0] = g.hg[0] + std::max(z_first - line.at(0), 0.0);
+    g.he[1] = g.hg[1] + std::max(z_last - line.at(n_), 0.0);
+    for (int j = 0; j < 2; ++j) g.dl[j] = horizon(g.he[j]);
+    const double sum = g.dl[0] + g.dl[1];
+    if (sum <= dist_) {
+      const double scale = (dist_ / sum) * (dist_ / sum);
+      for (int j = 0; j < 2; ++j) {
+        g.he[j] *= scale;
+        g.dl[j] = horizon(g.he[j]);
+      }
+    }
+    set_terms();
+    for (int j = 0; j < 2; ++j) {
+      const double q = g.terms[j].dls;  // sqrt(2 h_e / gamma_e)
+      g.the[j] = (0.65 * g.dh * (q / g.dl[j] - 1.0) - 2.0 * g.he[j]) / q;
+    }
+  } else {
+    g.he[0] = g.hg[0] + std::max(z_first - fit(xl0, 0.9 * g.dl[0]).at(0), 0.0);
+    g.he[1] = g.hg[1] + std::max(z_last - fit(dist_ - 0.9 * g.dl[1], xl1).at(n_), 0.0);
+    set_terms();
+  }
+
+  const Reference ref = reference_attenuation(g, m);
+
+  ItmLoss out;
+  out.warning = ref.warning;
+  out.reference_db = ref.aref;
+  out.mode = ref.mode;
+  const Statistics statistics{&kClimates[static_cast<int>(p_.climate) - 1], g_minus_, g_plus_, dexa_frequency_m_};
+  out.attenuation_db = variability(ref.aref, g, m, statistics, p_, z_time_, z_location_, z_situation_, out.warning);
+  out.free_space_db = free_space_path_db_;
+  out.loss_db = out.free_space_db + out.attenuation_db;
+  out.surface_refractivity = ns_;
+  out.earth_curvature = gme_;
+  out.delta_h_m = g.dh;
+  for (int j = 0; j < 2; ++j) {
+    out.effective_height_m[j] = g.he[j];
+    out.horizon_distance_m[j] = g.dl[j];
+    out.horizon_angle_rad[j] = g.the[j];
+  }
+  return out;
+}
+
+ItmLoss itm_point_to_point(std::span<const double> ground_m, double spacing_m, double tx_height_m, double rx_height_m,
+                           double frequency_mhz, const ItmParameters& parameters) {
+  ItmPath path(frequency_mhz, parameters);
+  path.set_profile(ground_m, spacing_m, tx_height_m);
+  return path.loss(rx_height_m);
+}
+
+namespace itm_functions {
+
+double knife_edge_db(double v2) {
+  return v2 < 5.76 ? 6.02 + 9.11 * std::sqrt(v2) - 1.27 * v2 : 12.953 + 4.343 * std::log(v2);
+}
+
+double height_gain_db(double x, double k) {
+  if (x < 200.0) {
+    const double w = -std::log(k);
+    if (k < 1e-5 || x * w * w * w > 5495.0) return x > 1.0 ? 17.372 * std::log(x) - 117.0 : -117.0;
+    return 2.5e-5 * x * x / k - 8.686 * w - 15.0;
+  }
+  const double ln_x = std::log(x);
+  double f = 0.05751 * x - 4.343 * ln_x;
+  if (x < 2000.0) {
+    const double w = 0.0134 * x * std::exp(-0.005 * x);
+    f = (1.0 - w) * f + w * (17.372 * ln_x - 117.0);
+  }
+  return f;
+}
+
+double frequency_gain_db(double r, double eta) {
+  static constexpr double a[5] = {25.0, 80.0, 177.0, 395.0, 705.0};
+  static constexpr double b[5] = {24.0, 45.0, 68.0, 80.0, 105.0};
+  int i = static_cast<int>(eta);  // eta >= 1 here; the curves are for eta_s = 1..5
+  double q = 0.0;
+  if (i <= 0) {
+    i = 1;
+  } else if (i >= 5) {
+    i = 5;
+  } else {
+    q = eta - i;
+  }
+  const double x = (1.0 / r) * (1.0 / r);
+  auto h = [&](int n) { return 4.343 * std::log((a[n - 1] * x + b[n - 1]) * x + 1.0); };
+  double h0 = h(i);
+  if (q != 0.0) h0 = (1.0 - q) * h0 + q * h(i + 1);
+  return h0;
+}
+
+double scatter_f_db(double theta_d) {
+  if (theta_d <= 10e3) return 133.4 + 0.332e-3 * theta_d - 4.343 * std::log(theta_d);
+  if (theta_d <= 70e3) return 104.6 + 0.212e-3 * theta_d - 1.086 * std::log(theta_d);
+  return 71.8 + 0.157e-3 * theta_d + 2.171 * std::log(theta_d);
+}
+
+double inverse_normal(double q) {
+  // Hastings' rational approximation (Abramowitz and Stegun 26.2.23), |error| < 4.5e-4.
+  constexpr double c0 = 2.515516698, c1 = 0.802853, c2 = 0.010328;
+  constexpr double d1 = 1.432788, d2 = 0.189269, d3 = 0.001308;
+  const double x = 0.5 - q;
+  double t = std::max(0.5 - std::abs(x), 0.000001);
+  t = std::sqrt(-2.0 * std::log(t));
+  const double v = t - ((c2 * t + c1) * t + c0) / (((d3 * t + d2) * t + d1) * t + 1.0);
+  return x < 0.0 ? -v : v;
+}
+
+double delta_h(std::span<const double> ground_m, double spacing_m, double x1_m, double x2_m) {
+  if (ground_m.size() < 2 || !(spacing_m > 0.0)) throw std::invalid_argument("delta_h: needs 2 samples and a spacing > 0");
+  DeltaHScratch scratch;
+  return delta_h_of(ground_m.data(), static_cast<int>(ground_m.size()) - 1, spacing_m, x1_m, x2_m, scratch);
+}
+
+}  // namespace itm_functions
+
+}  // namespace terravol::volume
