@@ -55,7 +55,7 @@ enum class RfModel {
 
 struct RfOptions {
   RfModel model = RfModel::kDeygout;
-  // Deygout only.
+  // Deygout's (with ITM only the antenna pattern's departure angle uses k_factor).
   double k_factor = 4.0 / 3.0;  // effective Earth radius factor (standard atmosphere)
   int edge_depth = 2;           // Deygout recursion levels: 1 = principal edge only, 2 = plus
                                 // one secondary edge on each side (3 edges, the usual form)
