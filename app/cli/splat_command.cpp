@@ -133,6 +133,9 @@ void run_splat_volume(const SplatCommandOptions& o) {
   if (!o.tx.empty()) {
     const volume::Transmitter tx = parse_tx(o.tx);
     antenna = tx.antenna;
+    if (antenna && o.check_itm) {
+      throw std::runtime_error("--check-itm: compares the ITM alone, without an antenna pattern in --tx");
+    }
     if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
       throw std::runtime_error("--tx " + o.tx +
                                ": SPLAT! takes frequencies within [20, 20000] MHz");

@@ -232,6 +232,7 @@ TEST(SplatCli, BadOptionsFailWithOneLine) {
   const auto bad_ano = dir.path() / "bad.ano";
   write(bad_ano, "113, 111\n41, 40\n40.5, 111.5, 1, 2\n");
   const std::string t = " --tx 40.5,-111.5,30";
+  write(dir.path() / "s.az", test::smooth_sector_texts().first);
   const std::pair<std::string, std::string> cases[] = {
       {out, "give the transmitter (--tx or --qth) and --sdf, or --import -ano files"},
       {t + out, "--sdf: the folder of SDF tiles is required"},
@@ -263,6 +264,8 @@ TEST(SplatCli, BadOptionsFailWithOneLine) {
       {" --import " + bad_ano.string() + " --olditm --heights 10" + out, "--olditm: not used with --import"},
       {" --import " + bad_ano.string() + " --check-itm --heights 10" + out, "--check-itm: needs a SPLAT! run with --olditm"},
       {t + sdf + " --check-itm" + out, "--check-itm: needs a SPLAT! run with --olditm (not --import)"},
+      {t + ",900,50,pattern=" + (dir.path() / "s.az").string() + sdf + " --olditm --check-itm" + out,
+       "--check-itm: compares the ITM alone, without an antenna pattern in --tx"},
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);
