@@ -20,12 +20,14 @@ struct CommandResult {
   double seconds = 0.0;
 };
 
-// Runs `terravol ARGS` through the shell with a time limit (coreutils timeout).
-inline CommandResult run_terravol(const std::string& args, int timeout_s = 30) {
+// Runs `LAUNCHER terravol ARGS` through the shell with a time limit (coreutils timeout); the
+// launcher may be empty, or e.g. "mpirun -np 2".
+inline CommandResult run_terravol_under(const std::string& launcher, const std::string& args, int timeout_s = 30) {
   static TempDir dir;
   const auto out = dir.path() / "stdout", err = dir.path() / "stderr";
-  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + std::string(TERRAVOL_EXE) + " " + args + " >" + out.string() + " 2>" +
-                          err.string() + " </dev/null";
+  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + launcher + (launcher.empty() ? "" : " ") +
+                          std::string(TERRAVOL_EXE) + " " + args + " >" + out.string() + " 2>" + err.string() +
+                          " </dev/null";
   const auto t0 = std::chrono::steady_clock::now();
   const int raw = std::system(cmd.c_str());
   CommandResult r;
@@ -38,6 +40,11 @@ inline CommandResult run_terravol(const std::string& args, int timeout_s = 30) {
   r.out = slurp(out);
   r.err = slurp(err);
   return r;
+}
+
+// Runs `terravol ARGS` through the shell with a time limit (coreutils timeout).
+inline CommandResult run_terravol(const std::string& args, int timeout_s = 30) {
+  return run_terravol_under("", args, timeout_s);
 }
 
 }  // namespace terravol::test

@@ -9,6 +9,8 @@
 //   under 1.8 for the others).
 // - coolwarm: K. Moreland, "Diverging Color Maps for Scientific Visualization" (ISVC 2009),
 //   CoolWarmFloat33, as in matplotlib `_cm.py`: all 33 points, exact up to 8-bit rounding.
+// - the categorical colours: matplotlib 3.6.3 `_cm.py` `_tab20_data` (Tableau 20), rounded to 8
+//   bits.
 // - jet: matplotlib `_cm.py` `_jet_data`, its per-channel breakpoints merged into 12 stops, so
 //   it is exact up to 8-bit rounding.
 #include "volume/colormap.h"
@@ -150,7 +152,23 @@ Colormap colormap_by_name(std::string_view name) {
   }
   std::string known;
   for (const Named& m : kMaps) known += (known.empty() ? "" : ", ") + std::string(m.name);
-  throw std::invalid_argument("unknown colour map '" + std::string(name) + "' (known: " + known + ", gray)");
+  if (is_categorical(name)) throw std::invalid_argument("'categorical' is a colour scheme for index fields, not a colour map");
+  throw std::invalid_argument("unknown colour map '" + std::string(name) + "' (known: " + known + ", gray, " +
+                              std::string(kCategorical) + ")");
+}
+
+glm::u8vec3 category_color(std::int64_t k) {
+  // tab20's pairs (dark, light) as matplotlib lists them: blue, orange, green, red, purple,
+  // brown, pink, grey, olive, cyan.
+  static constexpr std::array<glm::u8vec3, 20> kTab20{{
+      {31, 119, 180}, {174, 199, 232}, {255, 127, 14}, {255, 187, 120}, {44, 160, 44},
+      {152, 223, 138}, {214, 39, 40}, {255, 152, 150}, {148, 103, 189}, {197, 176, 213},
+      {140, 86, 75}, {196, 156, 148}, {227, 119, 194}, {247, 182, 210}, {127, 127, 127},
+      {199, 199, 199}, {188, 189, 34}, {219, 219, 141}, {23, 190, 207}, {158, 218, 229},
+  }};
+  const std::int64_t i = ((k - 1) % 20 + 20) % 20;  // 0..19
+  // Darks first (tab20's even entries), then lights.
+  return kTab20[static_cast<std::size_t>(i < 10 ? 2 * i : 2 * (i - 10) + 1)];
 }
 
 std::vector<std::string> colormap_names() {

@@ -4,6 +4,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
@@ -44,5 +45,18 @@ Colormap colormap_by_name(std::string_view name);
 
 // The known names, in the order the error message lists them (aliases excluded).
 std::vector<std::string> colormap_names();
+
+// "categorical": the colour scheme of index-valued fields such as `terravol rf`'s best_server
+// (1 = the first transmitter), which a slice draws without interpolating (geometry.h). It is
+// not a Colormap (no continuum between its colours); colormap_by_name() rejects it, slices and
+// scene files accept it beside the names above.
+inline constexpr std::string_view kCategorical = "categorical";
+inline bool is_categorical(std::string_view name) { return name == kCategorical; }
+
+// The colour of category k (k = 1, 2, ...): matplotlib's "tab20" qualitative palette (Tableau
+// 20) in the order dark 1, dark 2, ..., dark 10, light 1, ..., light 10, so that the first ten
+// categories get ten distinct hues; cycled after 20 (k and k + 20 share a colour). k <= 0 maps
+// like k + 20 * n with n making it positive.
+glm::u8vec3 category_color(std::int64_t k);
 
 }  // namespace terravol::volume

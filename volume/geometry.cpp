@@ -176,7 +176,7 @@ SliceSpec parse_slice(std::string_view text) {
     } else if (key == "colormap" || key == "colourmap") {
       once(e, seen_map, key);
       try {
-        spec.colormap = std::string(colormap_by_name(value).name());
+        spec.colormap = is_categorical(value) ? std::string(kCategorical) : std::string(colormap_by_name(value).name());
       } catch (const std::invalid_argument& x) {
         e.fail(x.what());
       }

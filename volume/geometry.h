@@ -90,7 +90,7 @@ enum class SliceKind : std::uint8_t {
 struct SliceSpec {
   SliceKind kind = SliceKind::kAgl;
   double value = 0.0;                // degrees (kLat, kLon) or metres (kAlt, kAgl)
-  std::string colormap = "viridis";  // colormap_by_name()
+  std::string colormap = "viridis";  // colormap_by_name(), or kCategorical (colormap.h)
   double opacity = 0.5;              // [0, 1]
   std::optional<float> lo, hi;       // the values mapped to the colour map's ends; each
                                      // defaults to the volume's finite minimum / maximum
@@ -107,7 +107,10 @@ struct SliceSpec {
 //   the ground convert through `ground`, whatever the frame's own HeightRef.
 // - Each vertex carries the volume's value trilinearly interpolated at its lattice position,
 //   mapped through the colour map with t = (v - lo) / (hi - lo) clamped to [0, 1] (t = 0.5 when
-//   lo == hi; lo > hi reverses the map), alpha = round(opacity * 255).
+//   lo == hi; lo > hi reverses the map), alpha = round(opacity * 255). With the colour map
+//   "categorical" (an index field such as best_server) the vertex carries instead the value of
+//   the nearest lattice point, coloured category_color(round(value)) (colormap.h); lo and hi
+//   are then unused.
 // - A quad is dropped when a corner's line does not cross the slice inside the volume, or its
 //   value is NaN (an interpolation weight > 0 on a NaN point).
 // Preconditions: `ground` is the ground `mapper` was built with (if any); it may be empty for
@@ -118,7 +121,7 @@ struct SliceSpec {
 // volume/textured_slice.h draws the same sheet simplified, with the colours as a texture.
 Mesh slice(const Volume& volume, const LatticeMapper& mapper, const SliceSpec& spec, const GroundFunction& ground);
 
-// Parses "KIND=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI]" with KIND one of lat, lon
+// Parses "KIND=VALUE[,colormap=NAME|categorical][,opacity=A][,range=LO:HI]" with KIND one of lat, lon
 // (degrees), alt, agl (metres), e.g. "agl=300" or "alt=2500,colormap=plasma,opacity=0.4,
 // range=-140:-60". Either side of the range may be empty ("range=-140:") to keep the default.
 // Throws std::invalid_argument("slice 'TEXT': ...") naming the bad part (one line).

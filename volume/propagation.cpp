@@ -28,8 +28,8 @@
 //
 // Limits, to keep in mind when reading the numbers:
 //  - No ground reflection (no two-ray interference lobes), no clutter (trees, buildings), no
-//    atmospheric absorption, rain, ducting or tropospheric scatter; isotropic antennas at both
-//    ends, polarisation ignored. Beyond the radio horizon over smooth ground the bulge acts as
+//    atmospheric absorption, rain, ducting or tropospheric scatter; an isotropic receiving
+//    antenna, the transmitting one isotropic unless it has a pattern; polarisation ignored. Beyond the radio horizon over smooth ground the bulge acts as
 //    knife edges, not P.526's smooth-Earth method.
 //  - Knife edges: a rounded hill is a knife edge at its most obstructing sample (no
 //    rounded-obstacle term), and a flat-topped ridge is one obstacle, not two edges (its far
@@ -42,10 +42,21 @@
 //    transmitter. The slant distance is clamped to 1 m.
 //  - The line in latitude and longitude departs from the geodesic by metres over tens of km,
 //    far less than a DEM sample.
+//  - Antenna pattern (antenna.h), a per-path term: the loss grows by the pattern's attenuation
+//    in the path's azimuth (the geodesic's at the transmitter) and departure elevation. The
+//    departure is the first leg of the path the construction traces, the string from the
+//    transmitter stretched over the knife edges to the receiver: the steepest of the lines from
+//    the transmitter to the edges and to the receiver (their elevation above the local
+//    horizontal of the k-factor Earth). SPLAT! (PlotLRPath) instead takes the line to the first
+//    terrain sample above the line of sight; on a diffracted path the two differ by up to the
+//    angle between the first obstruction and the highest edge.
 //
 // With RfModel::kItm the same profile goes to the Longley-Rice model instead (volume/itm.h,
 // whose effective Earth comes from the surface refractivity): the profile without the bulge,
-// the antennas' heights above the ground at its ends, basic transmission loss out.
+// the antennas' heights above the ground at its ends, basic transmission loss out. The antenna
+// pattern applies to it the same way (ColumnModel): ITM finds no knife edges, so its departure is
+// the steepest line from the transmitter over the whole profile (k-factor Earth), the horizon
+// ray of an obstructed path, the direct line of a clear one.
 #include "volume/propagation.h"
 
 #include <GeographicLib/Geodesic.hpp>
@@ -72,6 +83,7 @@ namespace {
 constexpr double kEarthRadius = 6371000.0;       // metres (ITU-R P.526's a)
 constexpr double kSpeedOfLight = 299792458.0;    // m/s
 constexpr double kDipoleGainDbi = 2.15;          // half-wave dipole over isotropic
+constexpr double kDegree = M_PI / 180.0;
 
 std::string num(double v) {
   char b[40];
@@ -83,8 +95,10 @@ std::string num(double v) {
 // (terrain already raised by the bulge; y[a] and y[b] are the ends: antennas at the top level,
 // edges below). edge_a / edge_b: that end is a knife edge, so the samples joined to it by
 // unbroken obstruction of this path (v > -0.78 from the end inward) belong to its obstacle and
-// are not edges of their own.
-double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool edge_b, double lambda, int depth) {
+// are not edges of their own. Each edge used is appended to `edges` when given (sample = its
+// index in x, y).
+double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool edge_b, double lambda, int depth,
+               std::vector<KnifeEdge>* edges, int level = 1) {
   if (b - a < 2 || depth < 1) return 0.0;
   const double xa = x[a], ya = y[a], xb = x[b];
   const double length = xb - xa;
@@ -114,9 +128,10 @@ double deygout(const double* x, const double* y, int a, int b, bool edge_a, bool
   const double v2 = best_key * 2.0 * length / lambda;
   const double v = best_key < 0.0 ? -std::sqrt(-v2) : std::sqrt(v2);
   const double principal = knife_edge_loss_db(v);
+  if (edges) edges->push_back({static_cast<std::size_t>(best), v, principal, level});
   if (depth == 1) return principal;
-  return principal + deygout(x, y, a, best, edge_a, true, lambda, depth - 1) +
-         deygout(x, y, best, b, true, edge_b, lambda, depth - 1);
+  return principal + deygout(x, y, a, best, edge_a, true, lambda, depth - 1, edges, level + 1) +
+         deygout(x, y, best, b, true, edge_b, lambda, depth - 1, edges, level + 1);
 }
 
 double wavelength(double frequency_mhz) { return kSpeedOfLight / (frequency_mhz * 1e6); }
@@ -146,6 +161,9 @@ class DemSampler {
 };
 
 constexpr double kItmMinHeight = 0.5, kItmMaxHeight = 3000.0;  // the Algorithm's antenna limits
+// ITM has no value at zero distance; a lattice column placed on another transmitter's grid can
+// land within rounding (nanometres) of its own transmitter, so "no path" is under a metre.
+constexpr double kItmMinDistance = 1.0;
 
 void bad(const std::string& what) { throw std::invalid_argument(what); }
 
@@ -191,11 +209,6 @@ void check_grid(const RfGrid& grid, const RfOptions& options) {
   }
 }
 
-void check_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
-  check_model(tx, options);
-  check_grid(grid, options);
-}
-
 std::vector<double> default_heights(RfModel model) {
   const double first = model == RfModel::kItm ? 10.0 : 0.0;
   std::vector<double> h;
@@ -203,7 +216,32 @@ std::vector<double> default_heights(RfModel model) {
   return h;
 }
 
+void check_dem(const io::Grid& dem) {
+  if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
+    throw std::invalid_argument("the DEM must be a geographic grid of at least 2 x 2 samples");
+  }
+}
+
+void check_inside(const DemExtent& e, double lat, double lon, const std::string& what) {
+  if (lat < e.south || lat > e.north || lon < e.west || lon > e.east) {
+    throw std::invalid_argument(what + " at " + num(lat) + ", " + num(lon) + " lies outside the DEM (" + num(e.south) +
+                                ".." + num(e.north) + " N, " + num(e.west) + ".." + num(e.east) + " E)");
+  }
+}
+
+// The profile step compute_rf uses for tx over this DEM: its finer spacing in metres at the
+// transmitter.
+double profile_step_m(const io::Grid& dem, const Transmitter& tx) {
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  return std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
+}
+
 }  // namespace
+
+void check_rf_parameters(const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
+  check_model(tx, options);
+  check_grid(grid, options);
+}
 
 double free_space_loss_db(double distance_m, double frequency_mhz) {
   return 20.0 * std::log10(4.0 * M_PI * distance_m / wavelength(frequency_mhz));
@@ -227,7 +265,8 @@ double diffraction_loss_db(const PathProfile& p, double frequency_mhz, double k_
   }
   x[n] = p.distance_m;
   y[n] = p.rx_height_m;
-  return deygout(x.data(), y.data(), 0, static_cast<int>(n), false, false, wavelength(frequency_mhz), edge_depth);
+  return deygout(x.data(), y.data(), 0, static_cast<int>(n), false, false, wavelength(frequency_mhz), edge_depth,
+                 nullptr);
 }
 
 double path_loss_db(const PathProfile& p, double frequency_mhz, double k_factor, int edge_depth) {
@@ -239,10 +278,11 @@ double path_loss_db(const PathProfile& p, double frequency_mhz, double k_factor,
 void sample_profile(const io::Grid& dem, double tx_lat, double tx_lon, double rx_lat, double rx_lon, double step_m,
                     TerrainProfile& out) {
   const DemSampler ground(dem);
-  double distance = 0.0;
-  GeographicLib::Geodesic::WGS84().Inverse(tx_lat, tx_lon, rx_lat, rx_lon, distance);
+  double distance = 0.0, azi1 = 0.0, azi2 = 0.0;
+  GeographicLib::Geodesic::WGS84().Inverse(tx_lat, tx_lon, rx_lat, rx_lon, distance, azi1, azi2);
   const int segments = std::max(1, static_cast<int>(std::ceil(distance / step_m)));
   out.distance_m = distance;
+  out.azimuth_deg = azi1 < 0.0 ? azi1 + 360.0 : azi1;
   out.ground_m.resize(static_cast<std::size_t>(segments) + 1);
   out.ground_m[0] = ground(tx_lat, tx_lon);
   // Along the line the grid position is affine in the sample index: stepped from the
@@ -257,8 +297,80 @@ struct ColumnModel::State {
   Transmitter tx;
   RfOptions options;
   double lambda = 0.0, two_ka = 0.0;
-  std::vector<double> x, y;      // Deygout's profile: distances, heights raised by the bulge
+  // The column in the raised frame: distances, terrain heights raised by the bulge (k-factor
+  // Earth); x[0] = 0 and y[0] the transmitter's top, y[last] the receiver's top (set per height).
+  std::vector<double> x, y;
+  std::vector<KnifeEdge> edges;
   std::optional<ItmPath> itm;
+
+  // x, y for a profile (both models: Deygout's terrain, and the departure's geometry).
+  void raise(const TerrainProfile& profile) {
+    const std::size_t n = profile.ground_m.size();
+    const int segments = static_cast<int>(n) - 1;
+    const double distance = profile.distance_m;
+    x.resize(n);
+    y.resize(n);
+    x[0] = 0.0;
+    y[0] = profile.ground_m[0] + tx.height_agl;
+    for (int m = 1; m < segments; ++m) {
+      const double t = static_cast<double>(m) / segments;
+      const double d = t * distance;
+      x[static_cast<std::size_t>(m)] = d;
+      y[static_cast<std::size_t>(m)] = profile.ground_m[static_cast<std::size_t>(m)] + d * (distance - d) / two_ka;
+    }
+    x[static_cast<std::size_t>(segments)] = distance;
+  }
+
+  // The steepest slope from the transmitter to the terrain samples (ITM's departure), -inf
+  // without samples. Precondition: raise(profile).
+  double terrain_slope() const {
+    double slope = -std::numeric_limits<double>::infinity();
+    for (std::size_t m = 1; m + 1 < x.size(); ++m) slope = std::max(slope, (y[m] - y[0]) / x[m]);
+    return slope;
+  }
+
+  // Departure elevation (degrees) of a path whose steepest line from the transmitter has
+  // `slope` in the raised frame, less the tilt of the local horizontal there (the bulge's
+  // slope at d = 0); and the pattern's gain there.
+  void departure(double slope, double distance, double azimuth, RfPath& p) const {
+    p.departure_deg = (std::atan(slope) - std::atan(distance / two_ka)) / kDegree;
+    p.antenna_gain_db = tx.antenna ? tx.antenna->gain_db(azimuth, p.departure_deg) : 0.0;
+  }
+
+  // One height's loss and its parts into p (not the profile); `want_edges`: Deygout's edges in
+  // p.edges (found anyway with a pattern). Precondition: raise(profile); for ITM the profile
+  // set on itm. `terrain` is terrain_slope() (ITM with a pattern only).
+  void evaluate(const TerrainProfile& profile, double rx_height_agl, double terrain, bool want_edges, RfPath& p) {
+    const std::size_t last = x.size() - 1;
+    const double distance = profile.distance_m;
+    const double rx_top = profile.ground_m[last] + rx_height_agl;
+    y[last] = rx_top;
+    const double dh = rx_top - y[0];
+    const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
+    const double direct = distance > 0.0 ? dh / distance : 0.0;
+    p.free_space_db = free_space_loss_db(slant, tx.frequency_mhz);
+    p.edges.clear();
+    p.itm_warning = 0;
+    if (itm) {
+      const ItmLoss r = itm->loss(rx_height_agl);
+      p.diffraction_db = r.loss_db - p.free_space_db;
+      p.itm_warning = static_cast<std::size_t>(r.warning);
+      if (tx.antenna || want_edges) departure(std::max(direct, terrain), distance, profile.azimuth_deg, p);
+      p.path_loss_db = r.loss_db - p.antenna_gain_db;
+      return;
+    }
+    const bool edges_needed = want_edges || tx.antenna.has_value();
+    p.diffraction_db = deygout(x.data(), y.data(), 0, static_cast<int>(last), false, false, lambda, options.edge_depth,
+                               edges_needed ? &p.edges : nullptr);
+    p.antenna_gain_db = 0.0;
+    if (edges_needed) {
+      // The first leg of the string over the edges: the steepest line to them or the receiver.
+      double slope = direct;
+      for (const KnifeEdge& e : p.edges) slope = std::max(slope, (y[e.sample] - y[0]) / x[e.sample]);
+      departure(slope, distance, profile.azimuth_deg, p);
+    }
+    p.path_loss_db = p.free_space_db + p.diffraction_db - p.antenna_gain_db;
+  }
 };
 
 ColumnModel::ColumnModel(const Transmitter& tx, const RfOptions& options) : s_(std::make_unique<State>()) {
@@ -281,39 +393,45 @@ std::size_t ColumnModel::path_loss(const TerrainProfile& profile, std::span<cons
   const double distance = profile.distance_m;
   std::size_t warned = 0;
   if (s.itm) {
-    if (!(distance > 0.0)) {
+    if (!(distance >= kItmMinDistance)) {
       for (float& v : out) v = std::numeric_limits<float>::quiet_NaN();
       return 0;
     }
     s.itm->set_profile(profile.ground_m, distance / static_cast<double>(n - 1), s.tx.height_agl);
-    for (std::size_t k = 0; k < heights.size(); ++k) {
-      const ItmLoss r = s.itm->loss(heights[k]);
-      out[k] = static_cast<float>(r.loss_db);
-      if (r.warning >= 3) ++warned;
+    if (!s.tx.antenna) {
+      // ITM's own loss; the pattern's geometry is not needed.
+      for (std::size_t k = 0; k < heights.size(); ++k) {
+        const ItmLoss r = s.itm->loss(heights[k]);
+        out[k] = static_cast<float>(r.loss_db);
+        if (r.warning >= 3) ++warned;
+      }
+      return warned;
     }
-    return warned;
   }
-  const int segments = static_cast<int>(n) - 1;
-  s.x.resize(n);
-  s.y.resize(n);
-  s.x[0] = 0.0;
-  s.y[0] = profile.ground_m[0] + s.tx.height_agl;
-  for (int m = 1; m < segments; ++m) {
-    const double t = static_cast<double>(m) / segments;
-    const double d = t * distance;
-    s.x[static_cast<std::size_t>(m)] = d;
-    s.y[static_cast<std::size_t>(m)] = profile.ground_m[static_cast<std::size_t>(m)] + d * (distance - d) / s.two_ka;
-  }
-  s.x[static_cast<std::size_t>(segments)] = distance;
+  s.raise(profile);
+  const double terrain = s.itm && s.tx.antenna ? s.terrain_slope() : 0.0;
+  RfPath p;
   for (std::size_t k = 0; k < heights.size(); ++k) {
-    const double rx_top = profile.ground_m[static_cast<std::size_t>(segments)] + heights[k];
-    s.y[static_cast<std::size_t>(segments)] = rx_top;
-    const double dh = rx_top - s.y[0];
-    const double slant = std::max(1.0, std::sqrt(distance * distance + dh * dh));
-    out[k] = static_cast<float>(free_space_loss_db(slant, s.tx.frequency_mhz) +
-                                deygout(s.x.data(), s.y.data(), 0, segments, false, false, s.lambda, s.options.edge_depth));
+    s.evaluate(profile, heights[k], terrain, false, p);
+    out[k] = static_cast<float>(p.path_loss_db);
+    if (p.itm_warning >= 3) ++warned;
   }
-  return 0;
+  return warned;
+}
+
+void ColumnModel::path(const TerrainProfile& profile, double rx_height_agl, RfPath& out) {
+  State& s = *s_;
+  if (s.itm) {
+    if (!(profile.distance_m >= kItmMinDistance)) {
+      out = RfPath{};
+      out.free_space_db = out.diffraction_db = out.path_loss_db = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    s.itm->set_profile(profile.ground_m, profile.distance_m / static_cast<double>(profile.ground_m.size() - 1),
+                       s.tx.height_agl);
+  }
+  s.raise(profile);
+  s.evaluate(profile, rx_height_agl, s.itm ? s.terrain_slope() : 0.0, true, out);
 }
 
 std::string ColumnModel::description() const {
@@ -337,78 +455,119 @@ double default_spacing_arcsec(double dem_spacing_arcsec, double radius_km) {
   return dem_spacing_arcsec * std::max(1.0, std::ceil(wanted_m / dem_m - 1e-9));
 }
 
-RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
-  check_parameters(tx, grid_in, options);
-  if (dem.georef.crs != io::Crs::kGeographic || dem.rows < 2 || dem.cols < 2 || dem.heights.size() != dem.size()) {
-    throw std::invalid_argument("the DEM must be a geographic grid of at least 2 x 2 samples");
-  }
-  const io::Georef& g = dem.georef;
-  const double west = g.x0, east = g.x0 + (dem.cols - 1) * g.dx;
-  const double north = g.y0, south = g.y0 - (dem.rows - 1) * g.dy;
-  if (tx.lat < south || tx.lat > north || tx.lon < west || tx.lon > east) {
-    throw std::invalid_argument("transmitter at " + num(tx.lat) + ", " + num(tx.lon) + " lies outside the DEM (" +
-                                num(south) + ".." + num(north) + " N, " + num(west) + ".." + num(east) + " E)");
-  }
-  RfGrid grid = grid_in;
-  if (grid.heights_agl.empty()) grid.heights_agl = default_heights(options.model);
-  if (grid.spacing_arcsec == 0.0) grid.spacing_arcsec = default_spacing_arcsec(g.dy * 3600.0, grid.radius_km);
+double dem_height(const io::Grid& dem, double lat, double lon) {
+  check_dem(dem);
+  return DemSampler(dem)(lat, lon);
+}
 
-  RfResult result;
+RfGrid resolve_grid(const RfGrid& grid, double dem_spacing_arcsec, RfModel model) {
+  RfGrid r = grid;
+  if (r.heights_agl.empty()) r.heights_agl = default_heights(model);
+  if (r.spacing_arcsec == 0.0) r.spacing_arcsec = default_spacing_arcsec(dem_spacing_arcsec, r.radius_km);
+  return r;
+}
+
+DemExtent dem_extent(const io::Georef& g, int rows, int cols) {
+  return {g.y0 - (rows - 1) * g.dy, g.y0, g.x0, g.x0 + (cols - 1) * g.dx};
+}
+
+RfBox rf_box(const DemExtent& e, const Transmitter& tx, const RfGrid& grid, double anchor_lat, double anchor_lon) {
   const io::SceneFrame frame(tx.lat, tx.lon);
   const double mlat = frame.metres_per_degree_lat(), mlon = frame.metres_per_degree_lon();
   const double s = grid.spacing_arcsec / 3600.0;
   const double radius_m = grid.radius_km * 1000.0;
-  const int n_lon = static_cast<int>(std::floor(radius_m / (s * mlon) + 1e-9));
-  const int n_lat = static_cast<int>(std::floor(radius_m / (s * mlat) + 1e-9));
   constexpr double eps = 1e-9;
-  const int i_lo = std::max(-n_lon, static_cast<int>(std::ceil((west - tx.lon) / s - eps)));
-  const int i_hi = std::min(n_lon, static_cast<int>(std::floor((east - tx.lon) / s + eps)));
-  const int j_lo = std::max(-n_lat, static_cast<int>(std::ceil((south - tx.lat) / s - eps)));
-  const int j_hi = std::min(n_lat, static_cast<int>(std::floor((north - tx.lat) / s + eps)));
-  if (i_lo != -n_lon || i_hi != n_lon || j_lo != -n_lat || j_hi != n_lat) {
-    result.notes.push_back("the box was clipped to the DEM's extent");
-  }
-
-  Volume& loss = result.path_loss;
-  loss.name = "path_loss_db";
-  loss.units = "dB";
-  loss.frame.kind = FrameKind::kGeographic;
-  loss.frame.height = HeightRef::kGround;
+  const double half_lon = std::floor(radius_m / (s * mlon) + eps) * s;
+  const double half_lat = std::floor(radius_m / (s * mlat) + eps) * s;
+  // Box indices relative to the anchor; with the transmitter as the anchor these are
+  // -n .. n (the half sides are whole steps).
+  const int i_box_lo = static_cast<int>(std::ceil((tx.lon - half_lon - anchor_lon) / s - eps));
+  const int i_box_hi = static_cast<int>(std::floor((tx.lon + half_lon - anchor_lon) / s + eps));
+  const int j_box_lo = static_cast<int>(std::ceil((tx.lat - half_lat - anchor_lat) / s - eps));
+  const int j_box_hi = static_cast<int>(std::floor((tx.lat + half_lat - anchor_lat) / s + eps));
+  const int i_lo = std::max(i_box_lo, static_cast<int>(std::ceil((e.west - anchor_lon) / s - eps)));
+  const int i_hi = std::min(i_box_hi, static_cast<int>(std::floor((e.east - anchor_lon) / s + eps)));
+  const int j_lo = std::max(j_box_lo, static_cast<int>(std::ceil((e.south - anchor_lat) / s - eps)));
+  const int j_hi = std::min(j_box_hi, static_cast<int>(std::floor((e.north - anchor_lat) / s + eps)));
+  RfBox box;
+  box.clipped = i_lo != i_box_lo || i_hi != i_box_hi || j_lo != j_box_lo || j_hi != j_box_hi;
   const auto& heights = grid.heights_agl;
   const int nh = static_cast<int>(heights.size());
-  Lattice& l = loss.lattice;
+  Lattice& l = box.lattice;
   l.dims = {i_hi - i_lo + 1, j_hi - j_lo + 1, nh};
-  l.origin = {tx.lon + i_lo * s, tx.lat + j_lo * s, heights[0]};
+  l.origin = {anchor_lon + i_lo * s, anchor_lat + j_lo * s, heights[0]};
   l.spacing = {s, s, nh > 1 ? heights[1] - heights[0] : 1.0};
+  if (l.dims[0] < 1 || l.dims[1] < 1) {
+    throw std::invalid_argument("the box around the transmitter at " + num(tx.lat) + ", " + num(tx.lon) +
+                                " holds no lattice column inside the DEM");
+  }
   if (static_cast<double>(l.dims[0]) * l.dims[1] * l.dims[2] > static_cast<double>(kMaxPoints)) {
     throw std::invalid_argument("the lattice " + std::to_string(l.dims[0]) + " x " + std::to_string(l.dims[1]) + " x " +
                                 std::to_string(nh) + " is too large (at most 2^28 points): use a coarser spacing");
   }
-  loss.values.assign(l.size(), 0.0f);
-  loss.active_points = l.size();
-  const ColumnModel prototype(tx, options);
-  loss.attributes = {
-      {"tx_lat", num(tx.lat)},
-      {"tx_lon", num(tx.lon)},
-      {"tx_height_agl_m", num(tx.height_agl)},
-      {"frequency_mhz", num(tx.frequency_mhz)},
-      {"model", prototype.description()},
-      {"vertical_datum", dem.vertical_datum},
-  };
-  if (options.model == RfModel::kDeygout) loss.attributes["k_factor"] = num(options.k_factor);
-  if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
+  return box;
+}
 
-  const double step_m = std::min(g.dx * mlon, g.dy * mlat);
-  const std::size_t n_columns = static_cast<std::size_t>(l.dims[0]) * static_cast<std::size_t>(l.dims[1]);
+RfPath rf_path(const io::Grid& dem, const Transmitter& tx, double rx_lat, double rx_lon, double rx_height_agl,
+               const RfOptions& options) {
+  RfGrid grid;
+  grid.heights_agl = {rx_height_agl};
+  check_rf_parameters(tx, grid, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  check_inside(e, rx_lat, rx_lon, "receiver");
+  ColumnModel model(tx, options);
+  TerrainProfile profile;
+  sample_profile(dem, tx.lat, tx.lon, rx_lat, rx_lon, profile_step_m(dem, tx), profile);
+  RfPath path;
+  model.path(profile, rx_height_agl, path);
+  std::sort(path.edges.begin(), path.edges.end(), [](const KnifeEdge& a, const KnifeEdge& b) { return a.sample < b.sample; });
+  for (KnifeEdge& edge : path.edges) --edge.sample;  // sample 0 of the column is the transmitter
+  const std::size_t segments = profile.ground_m.size() - 1;
+  PathProfile& p = path.profile;
+  p.distance_m = profile.distance_m;
+  p.tx_height_m = profile.ground_m[0] + tx.height_agl;
+  p.rx_height_m = profile.ground_m[segments] + rx_height_agl;
+  for (std::size_t m = 1; m < segments; ++m) {
+    p.d_m.push_back(static_cast<double>(m) / static_cast<double>(segments) * profile.distance_m);
+    p.z_m.push_back(profile.ground_m[m]);
+  }
+  path.azimuth_deg = profile.azimuth_deg;
+  return path;
+}
+
+RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattice& l, std::span<const int> rows,
+                        const RfOptions& options, std::span<float> out, double disc_radius_km) {
+  RfGrid grid;
+  for (int k = 0; k < l.dims[2]; ++k) grid.heights_agl.push_back(l.world(2, k));
+  check_rf_parameters(tx, grid, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  const std::size_t nx = static_cast<std::size_t>(l.dims[0]), nr = rows.size();
+  const int nh = l.dims[2];
+  if (out.size() != nx * nr * static_cast<std::size_t>(nh)) {
+    throw std::invalid_argument("compute_rf_rows: the output holds " + std::to_string(out.size()) + " values, not " +
+                                std::to_string(nx * nr * static_cast<std::size_t>(nh)));
+  }
+  for (const int j : rows) {
+    if (j < 0 || j >= l.dims[1]) throw std::invalid_argument("compute_rf_rows: row " + std::to_string(j) + " is outside the lattice");
+  }
+  const ColumnModel prototype(tx, options);  // checks the model's parameters once, here
+  const double step_m = profile_step_m(dem, tx);
+  const std::size_t n_columns = nx * nr;
   const std::size_t layer = n_columns;
-  std::vector<double> heights_m(static_cast<std::size_t>(nh));
-  for (int k = 0; k < nh; ++k) heights_m[static_cast<std::size_t>(k)] = l.world(2, k);
+  const std::vector<double>& heights_m = grid.heights_agl;
 
   // The disc: decided from the flat distance in the transmitter's frame where that is clearly
   // inside or outside (it is within 0.5% of the geodesic one over 500 km), by the geodesic
   // near the rim.
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double mlat = frame.metres_per_degree_lat(), mlon = frame.metres_per_degree_lon();
+  const double radius_m = disc_radius_km * 1000.0;
   auto outside_disc = [&](double lat, double lon) {
-    if (!grid.disc) return false;
+    if (!(disc_radius_km > 0.0)) return false;
     const double flat = std::hypot((lon - tx.lon) * mlon, (lat - tx.lat) * mlat);
     if (flat < 0.99 * radius_m) return false;
     if (flat > 1.01 * radius_m) return true;
@@ -416,6 +575,8 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, lat, lon, distance);
     return distance > radius_m;
   };
+
+  RfStats stats;
   std::atomic<std::size_t> done{0}, samples{0}, warned{0}, computed{0};
   std::mutex progress_mutex;
   int reported = -1;
@@ -426,17 +587,17 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
     std::vector<float> column(static_cast<std::size_t>(nh));
     std::size_t local_samples = 0, local_warned = 0, local_computed = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      const int i = static_cast<int>(c % static_cast<std::size_t>(l.dims[0]));
-      const int j = static_cast<int>(c / static_cast<std::size_t>(l.dims[0]));
+      const int i = static_cast<int>(c % nx);
+      const int j = rows[c / nx];
       if (outside_disc(l.world(1, j), l.world(0, i))) {
-        for (int k = 0; k < nh; ++k) loss.values[c + layer * static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
+        for (int k = 0; k < nh; ++k) out[c + layer * static_cast<std::size_t>(k)] = std::numeric_limits<float>::quiet_NaN();
         continue;
       }
       ++local_computed;
       sample_profile(dem, tx.lat, tx.lon, l.world(1, j), l.world(0, i), step_m, profile);
       local_samples += profile.ground_m.size() - 2;
       local_warned += model.path_loss(profile, heights_m, column);
-      for (int k = 0; k < nh; ++k) loss.values[c + layer * static_cast<std::size_t>(k)] = column[static_cast<std::size_t>(k)];
+      for (int k = 0; k < nh; ++k) out[c + layer * static_cast<std::size_t>(k)] = column[static_cast<std::size_t>(k)];
     }
     samples += local_samples;
     warned += local_warned;
@@ -451,72 +612,136 @@ RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& gr
       }
     }
   });
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  result.columns = computed.load();
-  result.mean_profile_samples = static_cast<double>(samples.load()) / static_cast<double>(std::max<std::size_t>(1, computed.load()));
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats.columns = computed.load();
+  stats.samples = samples.load();
+  stats.itm_warned = warned.load();
+  return stats;
+}
+
+Volume path_loss_volume(const Transmitter& tx, const Lattice& lattice, const RfOptions& options,
+                        const std::string& vertical_datum) {
+  Volume loss;
+  loss.name = "path_loss_db";
+  loss.units = "dB";
+  loss.frame.kind = FrameKind::kGeographic;
+  loss.frame.height = HeightRef::kGround;
+  loss.lattice = lattice;
+  loss.values.assign(lattice.size(), 0.0f);
+  loss.active_points = lattice.size();
+  loss.attributes = {
+      {"tx_lat", num(tx.lat)},
+      {"tx_lon", num(tx.lon)},
+      {"tx_height_agl_m", num(tx.height_agl)},
+      {"frequency_mhz", num(tx.frequency_mhz)},
+      {"model", ColumnModel(tx, options).description()},
+      {"vertical_datum", vertical_datum},
+  };
+  if (options.model == RfModel::kDeygout) loss.attributes["k_factor"] = num(options.k_factor);
+  if (tx.erp_w) loss.attributes["erp_w"] = num(*tx.erp_w);
+  if (!tx.name.empty()) loss.attributes["tx_name"] = tx.name;
+  if (tx.antenna) {
+    loss.attributes["antenna_pattern"] = tx.antenna->describe() +
+                                         "; the loss includes the pattern's attenuation along each path's departure";
+  }
+  return loss;
+}
+
+Volume signal_from_path_loss(Volume s, double erp_w) {
+  if (!(erp_w > 0.0) || !std::isfinite(erp_w)) throw std::invalid_argument("signal_from_path_loss: ERP must be > 0 W");
+  s.name = "signal_dbm";
+  s.units = "dBm";
+  // ERP is relative to a half-wave dipole: EIRP = ERP + 2.15 dB; the signal is the power an
+  // isotropic (0 dBi) receiving antenna delivers.
+  const double eirp_dbm = 10.0 * std::log10(erp_w) + 30.0 + kDipoleGainDbi;
+  for (float& x : s.values) x = static_cast<float>(eirp_dbm - x);
+  s.background = static_cast<float>(eirp_dbm - s.background);
+  s.attributes["erp_w"] = num(erp_w);
+  s.attributes["eirp_dbm"] = num(eirp_dbm);
+  s.attributes["signal"] = "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
+  return s;
+}
+
+std::vector<std::string> rf_notes(const RfStats& stats, std::size_t box_columns, std::size_t points, const RfGrid& grid,
+                                  const RfOptions& options) {
+  std::vector<std::string> notes;
   if (grid.disc) {
-    result.notes.push_back("the " + std::to_string(n_columns - computed.load()) + " columns farther than " +
-                           num(grid.radius_km) + " km from the transmitter are NaN (disc)");
-    loss.attributes["disc_radius_km"] = num(grid.radius_km);
+    notes.push_back("the " + std::to_string(box_columns - stats.columns) + " columns farther than " +
+                    num(grid.radius_km) + " km from the transmitter are NaN (disc)");
   }
   if (options.model == RfModel::kItm) {
-    result.notes.push_back("ITM has no value at the transmitter's own column (NaN)");
-    if (warned > 0) {
-      result.notes.push_back(std::to_string(warned.load()) + " of " + std::to_string(l.size()) +
-                             " points carry ITM warning 3 or 4: parameters outside the model's range (paths under 1 km, "
-                             "N_s under 250 N-units over high ground, steep horizons); computed anyway");
+    notes.push_back("ITM has no value at the transmitter's own column (NaN)");
+    if (stats.itm_warned > 0) {
+      notes.push_back(std::to_string(stats.itm_warned) + " of " + std::to_string(points) +
+                      " points carry ITM warning 3 or 4: parameters outside the model's range (paths under 1 km, "
+                      "N_s under 250 N-units over high ground, steep horizons); computed anyway");
     }
   }
+  return notes;
+}
 
-  if (tx.erp_w) {
-    Volume signal = loss;
-    signal.name = "signal_dbm";
-    signal.units = "dBm";
-    // ERP is relative to a half-wave dipole: EIRP = ERP + 2.15 dB; the signal is the power an
-    // isotropic (0 dBi) receiving antenna delivers.
-    const double eirp_dbm = 10.0 * std::log10(*tx.erp_w) + 30.0 + kDipoleGainDbi;
-    signal.attributes["eirp_dbm"] = num(eirp_dbm);
-    signal.attributes["signal"] = "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
-    for (float& v : signal.values) v = static_cast<float>(eirp_dbm - v);
-    result.signal = std::move(signal);
-  }
+RfResult compute_rf(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid_in, const RfOptions& options) {
+  check_rf_parameters(tx, grid_in, options);
+  check_dem(dem);
+  const DemExtent e = dem_extent(dem.georef, dem.rows, dem.cols);
+  check_inside(e, tx.lat, tx.lon, "transmitter");
+  const RfGrid grid = resolve_grid(grid_in, dem.georef.dy * 3600.0, options.model);
+  const RfBox box = rf_box(e, tx, grid, tx.lat, tx.lon);
+  RfResult result;
+  if (box.clipped) result.notes.push_back("the box was clipped to the DEM's extent");
+  result.path_loss = path_loss_volume(tx, box.lattice, options, dem.vertical_datum);
+  std::vector<int> rows(static_cast<std::size_t>(box.lattice.dims[1]));
+  for (std::size_t j = 0; j < rows.size(); ++j) rows[j] = static_cast<int>(j);
+  const RfStats stats = compute_rf_rows(dem, tx, box.lattice, rows, options, result.path_loss.values,
+                                        grid.disc ? grid.radius_km : 0.0);
+  result.seconds = stats.seconds;
+  result.columns = stats.columns;
+  result.mean_profile_samples =
+      static_cast<double>(stats.samples) / static_cast<double>(std::max<std::size_t>(1, stats.columns));
+  const std::size_t box_columns = static_cast<std::size_t>(box.lattice.dims[0]) * static_cast<std::size_t>(box.lattice.dims[1]);
+  for (auto& note : rf_notes(stats, box_columns, box.lattice.size(), grid, options)) result.notes.push_back(note);
+  if (grid.disc) result.path_loss.attributes["disc_radius_km"] = num(grid.radius_km);
+  if (tx.erp_w) result.signal = signal_from_path_loss(result.path_loss, *tx.erp_w);
   return result;
 }
 
-RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
-  check_parameters(tx, grid, options);
+RfWindow read_rf_window(const io::Mosaic& dem, const DemExtent& box) {
   const io::Georef& g = dem.georef();
-  const double west = g.x0, east = g.x0 + (dem.cols() - 1) * g.dx;
-  const double north = g.y0, south = g.y0 - (dem.rows() - 1) * g.dy;
-  if (tx.lat < south || tx.lat > north || tx.lon < west || tx.lon > east) {
-    throw std::invalid_argument("transmitter at " + num(tx.lat) + ", " + num(tx.lon) + " lies outside the DEM (" +
-                                num(south) + ".." + num(north) + " N, " + num(west) + ".." + num(east) + " E)");
-  }
-  const io::SceneFrame frame(tx.lat, tx.lon);
-  const double half_lat = grid.radius_km * 1000.0 / frame.metres_per_degree_lat() + 2.0 * g.dy;
-  const double half_lon = grid.radius_km * 1000.0 / frame.metres_per_degree_lon() + 2.0 * g.dx;
-  const int r0 = std::max(0, static_cast<int>(std::floor((g.y0 - (tx.lat + half_lat)) / g.dy)));
-  const int r1 = std::min(dem.rows() - 1, static_cast<int>(std::ceil((g.y0 - (tx.lat - half_lat)) / g.dy)));
-  const int c0 = std::max(0, static_cast<int>(std::floor((tx.lon - half_lon - g.x0) / g.dx)));
-  const int c1 = std::min(dem.cols() - 1, static_cast<int>(std::ceil((tx.lon + half_lon - g.x0) / g.dx)));
-  io::Grid window = dem.read_window(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
-  const std::size_t voids = io::count(window, io::Sample::kVoid), outside = io::count(window, io::Sample::kOutside);
-  io::fill_voids(window);
-
-  RfGrid resolved = grid;
-  if (resolved.spacing_arcsec == 0.0) resolved.spacing_arcsec = default_spacing_arcsec(g.dy * 3600.0, grid.radius_km);
-  RfResult result = compute_rf(window, tx, resolved, options);
+  const int r0 = std::max(0, static_cast<int>(std::floor((g.y0 - (box.north + 2.0 * g.dy)) / g.dy)));
+  const int r1 = std::min(dem.rows() - 1, static_cast<int>(std::ceil((g.y0 - (box.south - 2.0 * g.dy)) / g.dy)));
+  const int c0 = std::max(0, static_cast<int>(std::floor((box.west - 2.0 * g.dx - g.x0) / g.dx)));
+  const int c1 = std::min(dem.cols() - 1, static_cast<int>(std::ceil((box.east + 2.0 * g.dx - g.x0) / g.dx)));
+  if (r1 <= r0 || c1 <= c0) throw std::invalid_argument("the area lies outside the DEM");
+  RfWindow w;
+  w.grid = dem.read_window(r0, c0, r1 - r0 + 1, c1 - c0 + 1);
+  const std::size_t voids = io::count(w.grid, io::Sample::kVoid), outside = io::count(w.grid, io::Sample::kOutside);
+  io::fill_voids(w.grid);
   if (voids + outside > 0) {
-    result.notes.push_back(std::to_string(voids) + " void and " + std::to_string(outside) +
-                           " uncovered DEM samples were filled by interpolation");
+    w.notes.push_back(std::to_string(voids) + " void and " + std::to_string(outside) +
+                      " uncovered DEM samples were filled by interpolation");
   }
-  std::string tiles;
   for (const auto& t : dem.tiles()) {
     if (t.row0 + t.rows <= r0 || t.row0 > r1 || t.col0 + t.cols <= c0 || t.col0 > c1) continue;
-    tiles += (tiles.empty() ? "" : ", ") + t.path.filename().string();
+    w.tiles += (w.tiles.empty() ? "" : ", ") + t.path.filename().string();
   }
-  result.path_loss.attributes["dem"] = tiles;
-  if (result.signal) result.signal->attributes["dem"] = tiles;
+  return w;
+}
+
+DemExtent rf_area(const Transmitter& tx, double radius_km) {
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double half_lat = radius_km * 1000.0 / frame.metres_per_degree_lat();
+  const double half_lon = radius_km * 1000.0 / frame.metres_per_degree_lon();
+  return {tx.lat - half_lat, tx.lat + half_lat, tx.lon - half_lon, tx.lon + half_lon};
+}
+
+RfResult compute_rf(const io::Mosaic& dem, const Transmitter& tx, const RfGrid& grid, const RfOptions& options) {
+  check_rf_parameters(tx, grid, options);
+  check_inside(dem_extent(dem.georef(), dem.rows(), dem.cols()), tx.lat, tx.lon, "transmitter");
+  RfWindow window = read_rf_window(dem, rf_area(tx, grid.radius_km));
+  RfResult result = compute_rf(window.grid, tx, resolve_grid(grid, dem.georef().dy * 3600.0, options.model), options);
+  result.notes.insert(result.notes.end(), window.notes.begin(), window.notes.end());
+  result.path_loss.attributes["dem"] = window.tiles;
+  if (result.signal) result.signal->attributes["dem"] = window.tiles;
   return result;
 }
 

@@ -68,6 +68,14 @@ float trilinear(const Volume& v, const std::array<double, 3>& p) {
   return static_cast<float>(sum);
 }
 
+// The value of the lattice point nearest p (ties round away from zero): what a categorical
+// slice shows, since an index interpolated between two categories is neither.
+float nearest(const Volume& v, const std::array<double, 3>& p) {
+  std::array<int, 3> i{};
+  for (int a = 0; a < 3; ++a) i[a] = std::clamp(static_cast<int>(std::lround(p[a])), 0, v.lattice.dims[a] - 1);
+  return v.at(i[0], i[1], i[2]);
+}
+
 // Finds where lattice lines cross the slice, and the extent of the sliced quantity met on
 // their ends (for the error message).
 class Crossing {
@@ -186,7 +194,8 @@ SliceSheet slice_sheet(const Volume& volume, const LatticeMapper& mapper, const 
   if (spec.kind == SliceKind::kAgl && !ground) {
     throw std::invalid_argument("slice " + describe(spec) + ": heights above ground need a ground (DEM)");
   }
-  const Colormap colormap = colormap_by_name(spec.colormap);
+  const bool categorical = is_categorical(spec.colormap);
+  const Colormap colormap = colormap_by_name(categorical ? std::string_view("grey") : std::string_view(spec.colormap));
 
   // The colour range.
   double lo = 0.0, hi = 0.0;
@@ -204,6 +213,7 @@ SliceSheet slice_sheet(const Volume& volume, const LatticeMapper& mapper, const 
   if (spec.hi) hi = *spec.hi;
   const std::uint8_t alpha = static_cast<std::uint8_t>(std::lround(spec.opacity * 255.0));
   auto color_of = [&](float v) {
+    if (categorical) return glm::u8vec4(category_color(std::llround(v)), alpha);
     const double t = hi == lo ? 0.5 : (v - lo) / (hi - lo);
     const glm::u8vec3 rgb = colormap.map(t);
     return glm::u8vec4(rgb, alpha);
@@ -232,7 +242,7 @@ SliceSheet slice_sheet(const Volume& volume, const LatticeMapper& mapper, const 
       if (!crossing.find(p)) continue;
       const std::size_t id = sheet.index(u, v);
       any = true;
-      const float value = trilinear(volume, p);
+      const float value = categorical ? nearest(volume, p) : trilinear(volume, p);
       sheet.value[id] = value;
       const io::ScenePoint s = mapper.scene(p[0], p[1], p[2]);
       sheet.position[id] = {s.x, s.y, s.z};

@@ -38,12 +38,21 @@
 #include "io/dem_file.h"
 #include "io/error.h"
 #include "io/sdf_name.h"
+#include "volume/text.h"
 
 namespace terravol::volume {
 
 namespace {
 
-constexpr double kDipoleGainDbi = 2.15;  // as volume/propagation.cpp: EIRP = ERP + 2.15 dB
+using text::for_each_line;
+using text::quote_token;
+using text::split_on;
+using text::split_whitespace;
+using text::strip_comment;
+using text::to_number;
+using text::trim;
+
+constexpr double kSplatDipoleGainDbi = 2.14;  // SPLAT!'s own (PlotLRPath: "ERP + 2.14")
 constexpr double kFeet = 0.3048;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
@@ -51,78 +60,6 @@ std::string num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.10g", v);
   return b;
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
-    s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-    s.remove_suffix(1);
-  return s;
-}
-
-// A token for a message: quoted, at most 24 characters, non-printable bytes as '?'.
-std::string quote_token(std::string_view token) {
-  std::string s = "'";
-  for (std::size_t i = 0; i < token.size() && i < 24; ++i) {
-    const char c = token[i];
-    s += (c >= 0x20 && c < 0x7f) ? c : '?';
-  }
-  if (token.size() > 24) s += "...";
-  return s + "'";
-}
-
-// A finite number filling the whole (trimmed) text, or nothing.
-std::optional<double> to_number(std::string_view text) {
-  text = trim(text);
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
-    return std::nullopt;
-  return v;
-}
-
-// Splits text into lines (without '\n'); calls f(line_number, line) for each.
-template <typename F>
-void for_each_line(std::string_view text, F&& f) {
-  std::size_t start = 0, line = 1;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    f(line, text.substr(start, end - start));
-    start = end + 1;
-    ++line;
-  }
-}
-
-std::string_view strip_comment(std::string_view line) {
-  const std::size_t semi = line.find(';');
-  return trim(semi == std::string_view::npos ? line : line.substr(0, semi));
-}
-
-std::vector<std::string_view> split_on(std::string_view text, char sep) {
-  std::vector<std::string_view> parts;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = text.find(sep, start);
-    parts.push_back(
-        text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
-    if (end == std::string_view::npos) return parts;
-    start = end + 1;
-  }
-}
-
-std::vector<std::string_view> split_whitespace(std::string_view text) {
-  std::vector<std::string_view> parts;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < text.size() && text[i] != ' ' && text[i] != '\t') ++i;
-    if (i > start) parts.push_back(text.substr(start, i - start));
-  }
-  return parts;
 }
 
 double wrap180(double lon) {
@@ -466,22 +403,6 @@ AnoStack stack_ano(const std::vector<AnoLayer>& layers, int cells_per_degree) {
   return out;
 }
 
-Volume signal_from_path_loss(const Volume& path_loss, double erp_w) {
-  if (!(erp_w > 0.0) || !std::isfinite(erp_w))
-    throw std::invalid_argument("signal_from_path_loss: ERP must be > 0 W");
-  Volume s = path_loss;
-  s.name = "signal_dbm";
-  s.units = "dBm";
-  const double eirp_dbm = 10.0 * std::log10(erp_w) + 30.0 + kDipoleGainDbi;
-  for (float& x : s.values) x = static_cast<float>(eirp_dbm - x);
-  s.background = static_cast<float>(eirp_dbm - s.background);
-  s.attributes["erp_w"] = num(erp_w);
-  s.attributes["eirp_dbm"] = num(eirp_dbm);
-  s.attributes["signal"] =
-      "EIRP (ERP + 2.15 dB) minus path loss: power at an isotropic receiving antenna";
-  return s;
-}
-
 // ---- running SPLAT! ----
 
 namespace {
@@ -761,14 +682,21 @@ SplatRunResult run_splat(const SplatRunOptions& o) {
   if (site.name.empty() || site.name.front() == '.') site.name = "tx" + site.name;
   write_text(work.path() / "tx.qth", format_qth(site));
   write_text(work.path() / "tx.lrp", format_lrp(o.lrp));
+  // With a pattern, SPLAT! reports power (dBm) for an ERP; without, path loss (-erp 0).
+  const double run_erp_w = o.antenna ? o.lrp.erp_w.value_or(1.0) : 0.0;
+  if (o.antenna) {
+    if (o.antenna->azimuth) write_text(work.path() / "tx.az", splat_az_text(*o.antenna));
+    if (o.antenna->elevation) write_text(work.path() / "tx.el", splat_el_text(*o.antenna));
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t n = 0; n < o.heights_agl.size(); ++n) {
     const std::string h = num(o.heights_agl[n]);
     const std::string ano = "rx-" + std::to_string(n) + ".ano",
                       log_name = "splat-" + std::to_string(n) + ".log";
-    std::vector<std::string> args = {
-        exe, "-t", "tx.qth", "-L", h, "-R", num(o.radius_km), "-metric", "-erp", "0", "-ano", ano};
+    std::vector<std::string> args = {exe, "-t", "tx.qth", "-L", h, "-R", num(o.radius_km), "-metric",
+                                     "-erp", num(run_erp_w), "-ano", ano};
+    if (o.antenna) args.push_back("-dbm");
     if (o.olditm) args.push_back("-olditm");
     const std::string what = "splat -L " + h;
     const ChildOutcome c = run_child(args, work.path(), work.path() / log_name, o.timeout_seconds);
@@ -794,6 +722,11 @@ SplatRunResult run_splat(const SplatRunOptions& o) {
     if (!ok || text.empty())
       throw std::runtime_error(what + ": wrote no -ano file; it last printed " + last_line(log));
     result.maps.push_back(parse_ano(text, what + " output"));
+    if (o.antenna) {
+      // Inverts SPLAT!'s dBm = 10 log10(1000 ERP / 10^((loss - 2.14) / 10)).
+      const double eirp_dbm = 10.0 * std::log10(run_erp_w * 1000.0) + kSplatDipoleGainDbi;
+      for (AnoPoint& p : result.maps.back().points) p.value = static_cast<float>(eirp_dbm - p.value);
+    }
     if (o.keep_ano_texts) result.ano_texts.push_back(std::move(text));
     if (o.progress) o.progress(n + 1);
   }

@@ -15,6 +15,8 @@
 #include <string_view>
 #include <vector>
 
+#include "volume/antenna.h"
+#include "volume/propagation.h"
 #include "volume/volume.h"
 
 namespace terravol::volume {
@@ -120,10 +122,7 @@ struct AnoStack {
 AnoStack stack_ano(const std::vector<AnoLayer>& layers,
                    int cells_per_degree = kSplatCellsPerDegree);
 
-// The signal grid of a path-loss volume as `terravol rf` computes it: "signal_dbm", dBm,
-// EIRP (ERP + 2.15 dB, ERP relative to a half-wave dipole) minus path loss; NaN stays NaN.
-// Precondition: erp_w > 0 (std::invalid_argument).
-Volume signal_from_path_loss(const Volume& path_loss, double erp_w);
+// The signal grid of a stacked path-loss volume: signal_from_path_loss (propagation.h).
 
 struct SplatRunOptions {
   std::filesystem::path executable = "/usr/bin/splat";
@@ -139,12 +138,19 @@ struct SplatRunOptions {
   std::filesystem::path work_root;   // where the temporary working folder goes; empty: the
                                      // system's temporary folder
   bool keep_ano_texts = false;       // fill SplatRunResult::ano_texts
+  // The transmitting antenna's pattern, written beside tx.qth as tx.az / tx.el (splat_az_text,
+  // splat_el_text) for SPLAT! to apply. SPLAT! applies a pattern only to field strength and
+  // power, so with one each run is `-erp E -dbm` (E the .lrp's ERP, else 1 W) and the maps'
+  // values are turned back into the loss it used, 10 log10(E / 1 mW) + 2.14 - dBm (SPLAT!'s
+  // EIRP = ERP + 2.14 dB): the path loss plus the pattern's attenuation towards each point.
+  std::optional<AntennaPattern> antenna;
   // Called after each height with the count done (1 .. heights), from the calling thread.
   std::function<void(std::size_t done)> progress;
 };
 
 struct SplatRunResult {
-  std::vector<AnoMap> maps;            // one per height, in order
+  std::vector<AnoMap> maps;            // one per height, in order; values are path loss in dB
+                                       // (with the pattern's attenuation, given an antenna)
   std::vector<std::string> ano_texts;  // the -ano files as SPLAT! wrote them, one per height,
                                        // when SplatRunOptions::keep_ano_texts
   std::vector<std::string> tiles;      // the SDF files given to SPLAT! (names in the folder)

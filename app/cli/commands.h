@@ -17,5 +17,7 @@ void add_splat_command(CLI::App& app);       // terravol splat-volume --tx ... -
 void add_compare_command(CLI::App& app);     // terravol compare-volumes A.vdb B.vdb
 void add_image_diff_command(CLI::App& app);   // terravol compare-images A.png B.png
 void add_export_map_command(CLI::App& app);  // terravol export-map --volume V.vdb --agl H -o OUT.tif|.kmz
+void add_profile_command(CLI::App& app);      // terravol profile --from ... --to ... --dem DEM...
+void add_query_command(CLI::App& app);        // terravol query --volume V.vdb --dem DEM... --at ...
 
 }  // namespace terravol::app::cli

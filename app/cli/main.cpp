@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "app/cli/commands.h"
+#include "app/cli/mpi_session.h"
 #include "bench/bench_command.h"
 #include "io/error.h"
 
@@ -24,11 +25,15 @@ int main(int argc, char** argv) {
   terravol::app::cli::add_compare_command(app);
   terravol::app::cli::add_image_diff_command(app);
   terravol::app::cli::add_export_map_command(app);
+  terravol::app::cli::add_profile_command(app);
+  terravol::app::cli::add_query_command(app);
   terravol::bench::add_bench_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const terravol::app::cli::QuietFailure&) {
+    return 1;  // another MPI rank printed why
   } catch (const terravol::io::FormatError& e) {
     std::fprintf(stderr, "terravol: %s\n", e.what());
     return 1;

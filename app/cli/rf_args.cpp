@@ -1,8 +1,13 @@
 // Parsing of the options `terravol rf` and `terravol splat-volume` share (rf_args.h).
 #include "app/cli/rf_args.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
+#include <map>
+#include <optional>
 #include <stdexcept>
 
 namespace terravol::app::cli {
@@ -31,15 +36,18 @@ bool to_number(const std::string& text, double& out) {
 
 }  // namespace
 
-volume::Transmitter parse_tx(const std::string& text) {
-  auto bad = [&](const std::string& what) {
-    throw std::runtime_error("--tx " + text + ": " + what);
-  };
+volume::Transmitter parse_tx(const std::string& text, const std::string& where_in, const std::filesystem::path& base) {
+  const std::string where = where_in.empty() ? "--tx " + text : where_in;
+  auto bad = [&](const std::string& what) { throw std::runtime_error(where + ": " + what); };
   const auto parts = split(text, ',');
-  if (parts.size() < 3 || parts.size() > 5) bad("expected LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]]");
+  std::size_t positional = 0;
+  while (positional < parts.size() && parts[positional].find('=') == std::string::npos) ++positional;
+  if (positional < 3 || positional > 5) {
+    bad("expected LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,name=NAME][,pattern=FILE.az[:FILE.el]][,azimuth=DEG][,tilt=DEG]");
+  }
   double v[5] = {0, 0, 0, 900.0, 0};
   static const char* names[] = {"latitude", "longitude", "height", "frequency", "ERP"};
-  for (std::size_t n = 0; n < parts.size(); ++n) {
+  for (std::size_t n = 0; n < positional; ++n) {
     if (!to_number(parts[n], v[n]))
       bad(std::string(names[n]) + " '" + parts[n] + "' is not a number");
   }
@@ -47,14 +55,75 @@ volume::Transmitter parse_tx(const std::string& text) {
   if (std::abs(v[1]) > 180.0) bad("longitude must be within [-180, 180] degrees");
   if (v[2] < 0.0 || v[2] > 100000.0) bad("height must be within [0, 100000] m above ground");
   if (v[3] <= 0.0 || v[3] > 100000.0) bad("frequency must be within (0, 100000] MHz");
-  if (parts.size() == 5 && (v[4] <= 0.0 || v[4] > 1e9)) bad("ERP must be within (0, 1e9] W");
+  if (positional == 5 && (v[4] <= 0.0 || v[4] > 1e9)) bad("ERP must be within (0, 1e9] W");
   volume::Transmitter tx;
   tx.lat = v[0];
   tx.lon = v[1];
   tx.height_agl = v[2];
   tx.frequency_mhz = v[3];
-  if (parts.size() == 5) tx.erp_w = v[4];
+  if (positional == 5) tx.erp_w = v[4];
+
+  std::map<std::string, std::string> keyed;
+  for (std::size_t n = positional; n < parts.size(); ++n) {
+    const std::size_t eq = parts[n].find('=');
+    if (eq == std::string::npos) bad("'" + parts[n] + "': numbers come first, then KEY=VALUE fields");
+    const std::string key = parts[n].substr(0, eq), value = parts[n].substr(eq + 1);
+    if (key != "name" && key != "pattern" && key != "azimuth" && key != "tilt")
+      bad("unknown field '" + key + "' (expected name, pattern, azimuth or tilt)");
+    if (!keyed.emplace(key, value).second) bad(key + " given twice");
+  }
+  if (const auto it = keyed.find("name"); it != keyed.end()) {
+    const std::string& name = it->second;
+    const bool ok = !name.empty() && name.size() <= 32 && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+      return std::isalnum(c) || c == '_' || c == '-' || c == '.';
+    });
+    if (!ok) bad("name '" + name + "': 1 to 32 letters, digits, '_', '-' or '.'");
+    tx.name = name;
+  }
+  std::optional<double> azimuth, tilt;
+  for (const char* key : {"azimuth", "tilt"}) {
+    const auto it = keyed.find(key);
+    if (it == keyed.end()) continue;
+    double a = 0.0;
+    if (!to_number(it->second, a)) bad(std::string(key) + " '" + it->second + "' is not a number of degrees");
+    (std::string(key) == "azimuth" ? azimuth : tilt) = a;
+  }
+  const auto pattern = keyed.find("pattern");
+  if (pattern == keyed.end()) {
+    if (azimuth || tilt) bad(std::string(azimuth ? "azimuth" : "tilt") + " needs pattern=FILE.az[:FILE.el]");
+    return tx;
+  }
+  std::string spec = pattern->second;
+  if (!base.empty()) {
+    const std::size_t colon = spec.find(':');
+    auto resolve = [&](const std::string& file) {
+      return file.empty() || std::filesystem::path(file).is_absolute() ? file : (base / file).string();
+    };
+    spec = colon == std::string::npos ? resolve(spec) : resolve(spec.substr(0, colon)) + ":" + resolve(spec.substr(colon + 1));
+  }
+  try {
+    tx.antenna = volume::read_antenna_pattern(spec, azimuth, tilt);
+  } catch (const std::exception& e) {
+    bad(e.what());
+  }
   return tx;
+}
+
+std::vector<volume::Transmitter> read_tx_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  std::vector<volume::Transmitter> out;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+    std::size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line[start] == '#') continue;
+    out.push_back(parse_tx(line.substr(start), path + ": line " + std::to_string(n),
+                           std::filesystem::path(path).parent_path()));
+  }
+  if (in.bad()) throw std::runtime_error(path + ": cannot read");
+  if (out.empty()) throw std::runtime_error(path + ": no transmitter (one --tx text per line)");
+  return out;
 }
 
 // "START:STOP:STEP" (STOP included when it falls on a step), "H1,H2,..." evenly spaced, or "H".

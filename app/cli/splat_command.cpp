@@ -129,8 +129,13 @@ void run_splat_volume(const SplatCommandOptions& o) {
   std::optional<volume::SplatSite> site;
   volume::SplatLrp lrp;
   bool have_lrp = false;
+  std::optional<volume::AntennaPattern> antenna;
   if (!o.tx.empty()) {
     const volume::Transmitter tx = parse_tx(o.tx);
+    antenna = tx.antenna;
+    if (antenna && o.check_itm) {
+      throw std::runtime_error("--check-itm: compares the ITM alone, without an antenna pattern in --tx");
+    }
     if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
       throw std::runtime_error("--tx " + o.tx +
                                ": SPLAT! takes frequencies within [20, 20000] MHz");
@@ -154,16 +159,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
   }
 
   const std::string out = o.output.string();
-  std::string ext = o.output.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".vdb") throw std::runtime_error("-o " + out + ": expected a .vdb file name");
-  if (!o.force && std::filesystem::exists(o.output))
-    throw std::runtime_error(out + ": exists (use --force to overwrite)");
-  const auto folder = o.output.parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
-    throw std::runtime_error("-o " + out + ": folder " + folder.string() + " does not exist");
-  }
+  output::check_output_path(o.output, "-o", ".vdb", o.force);
   if (!o.ano_dir.empty()) {
     if (!std::filesystem::is_directory(o.ano_dir))
       throw std::runtime_error("--ano-dir " + o.ano_dir.string() + ": not a folder");
@@ -198,6 +194,7 @@ void run_splat_volume(const SplatCommandOptions& o) {
     run.radius_km = o.radius_km;
     run.timeout_seconds = o.timeout_seconds;
     run.keep_ano_texts = !o.ano_dir.empty();
+    run.antenna = antenna;
     run.olditm = o.olditm;
     const bool show_progress = !o.quiet && ::isatty(2);
     if (show_progress) {
@@ -216,8 +213,12 @@ void run_splat_volume(const SplatCommandOptions& o) {
     for (const auto& t : r.tiles) tiles += (tiles.empty() ? "" : ", ") + t;
     attributes["model"] =
         "SPLAT! " + (r.version.empty() ? std::string("(version unknown)") : "v" + r.version) +
-        " area path loss (" + (o.olditm ? "ITM" : "ITWOM") + "), splat -L H -R " + fmt(o.radius_km) +
-        " -metric -erp 0" + (o.olditm ? " -olditm" : "");
+        " area path loss (" + (o.olditm ? "ITM" : "ITWOM") + "), splat -L H -R " + fmt(o.radius_km) + " -metric " +
+        (antenna ? "-erp " + fmt(lrp.erp_w.value_or(1.0)) + " -dbm (dBm turned back into loss)" : "-erp 0") +
+        (o.olditm ? " -olditm" : "");
+    if (antenna) {
+      attributes["antenna_pattern"] = antenna->describe() + "; the loss includes the pattern's attenuation (SPLAT!'s)";
+    }
     attributes["radius_km"] = fmt(o.radius_km);
     attributes["dem"] = tiles;
     summary = "SPLAT! " + r.version + ": " + std::to_string(heights.size()) + " runs in " +
@@ -294,9 +295,9 @@ void add_splat_command(CLI::App& app) {
                                  "written as .vdb");
   auto o = std::make_shared<SplatCommandOptions>();
   cmd->add_option("--tx", o->tx,
-                  "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]] as for terravol rf (default "
-                  "900 MHz; an ERP adds "
-                  "a signal_dbm grid); SPLAT!'s other parameters are its defaults");
+                  "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,pattern=FILE.az[:FILE.el]][,azimuth=DEG]"
+                  "[,tilt=DEG] as for terravol rf (default 900 MHz; an ERP adds a signal_dbm grid; the pattern "
+                  "goes to SPLAT! as tx.az/tx.el); SPLAT!'s other parameters are its defaults");
   cmd->add_option("--qth", o->qth, "Transmitter as a SPLAT! .qth file (instead of --tx)");
   cmd->add_option("--lrp", o->lrp,
                   "SPLAT! .lrp file for --qth (default: the .qth's name with .lrp)");

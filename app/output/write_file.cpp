@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -26,6 +28,19 @@ void write_file_atomically(const std::filesystem::path& path, const std::vector<
     }
   }
   std::filesystem::rename(tmp, path);
+}
+
+void check_output_path(const std::filesystem::path& path, const std::string& option, const std::string& extension,
+                       bool overwrite) {
+  const std::string s = path.string();
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (!extension.empty() && ext != extension) throw std::runtime_error(option + " " + s + ": expected a " + extension + " file name");
+  if (!overwrite && std::filesystem::exists(path)) throw std::runtime_error(s + ": exists (use --force to overwrite)");
+  const auto folder = path.parent_path();
+  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+    throw std::runtime_error(option + " " + s + ": folder " + folder.string() + " does not exist");
+  }
 }
 
 }  // namespace terravol::app::output

@@ -307,6 +307,23 @@ const scene::MergeFigures& SceneRenderer::remerge() {
 
 std::vector<std::uint8_t> SceneRenderer::rgb() const { return renderer_->rgb(); }
 
+std::optional<Pick> SceneRenderer::pick(int x, int y) const {
+  const auto t0 = scene::Clock::now();
+  const scene::WindowBounds b = scene_->bounds();
+  const auto inside = [&](double lat, double lon) { return lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east; };
+  const auto ground = [&](double lat, double lon) { return scene_->ground_height(lat, lon); };
+  const glm::dvec3 eye = camera_.eye;
+  const std::optional<scene::PickPoint> p = scene::pick(scene::pixel_ray(camera_, x, y), scene_->frame(), ground, inside,
+                                                        volumes_.visible_mesh(), scene_->far_plane(eye));
+  if (!p) return std::nullopt;
+  Pick out;
+  out.point = *p;
+  out.ground = ground_height(p->where.lat, p->where.lon);
+  out.values = volumes_.values_at(p->where.lat, p->where.lon, p->where.h - out.ground, out.ground);
+  out.ms = scene::ms_since(t0);
+  return out;
+}
+
 double SceneRenderer::ground_height(double lat, double lon) const {
   const scene::WindowBounds b = scene_->bounds();
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);

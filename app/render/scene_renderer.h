@@ -18,6 +18,7 @@
 
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera.h"
+#include "app/scene/pick.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
 #include "app/scene/terrain_colors.h"
@@ -64,6 +65,14 @@ struct SlideFigures {
   double read_ms = 0;   // reading the moved window (kAsynchronous: on the worker thread)
   double shade_ms = 0;  // shading it (kAsynchronous: on the worker; kSynchronous: after the tree)
   double tree_ms = 0, vertices_ms = 0;  // sliding the tree (merging again), replacing the renderer's vertices
+};
+
+// What is under a pixel (SceneRenderer::pick).
+struct Pick {
+  scene::PickPoint point;                 // where, and whether on a surface or the terrain
+  double ground = 0;                      // the DEM's ground under it, metres above the datum
+  std::vector<scene::PointValue> values;  // each visible volume's value there
+  double ms = 0;                          // what the pick took, wall clock
 };
 
 class SceneRenderer {
@@ -118,6 +127,12 @@ class SceneRenderer {
   const SlideFigures& last_slide() const { return last_slide_; }
 
   std::vector<std::uint8_t> rgb() const;  // the last image: width * height * 3 bytes, top row first
+
+  // The point under pixel (x, y) of the last frame (x from the left, y from the bottom: VTK's
+  // event positions), on the window's terrain or on the nearest isosurface or slice in front of
+  // it (scene::pick over visible_mesh()), with the ground under it and the visible volumes'
+  // values there. Nothing when the pixel shows sky or lies beyond the window.
+  std::optional<Pick> pick(int x, int y) const;
 
   // Bilinear ground height (metres, DEM datum) anywhere in the mosaic, voids filled.
   double ground_height(double lat, double lon) const;

@@ -513,7 +513,13 @@ void TerrainRenderer::set_legend(const scene::Legend& legend) {
     if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
     card.lo = legend.lo;
     card.hi = legend.hi;
-    card.entries_title = "isosurfaces";
+    // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
+    card.entries_title = legend.categories.empty() ? "isosurfaces"
+                         : legend.levels.empty()   ? legend.categories_title
+                                                   : legend.categories_title + ", isosurfaces";
+    for (const scene::LegendLevel& l : legend.categories) {
+      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
+    }
     for (const scene::LegendLevel& l : legend.levels) {
       card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
     }

@@ -63,7 +63,7 @@ volume::SliceSpec slice_of(const Reader& r, const json& j, const std::string& wh
   if (j.contains("colormap")) {
     s.colormap = r.string(j["colormap"], Reader::join(where, "colormap"));
     try {
-      volume::colormap_by_name(s.colormap);
+      if (!volume::is_categorical(s.colormap)) volume::colormap_by_name(s.colormap);
     } catch (const std::invalid_argument& e) {
       r.fail(Reader::join(where, "colormap"), e.what());
     }

@@ -3,14 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "app/scene/ground_grid.h"
 #include "app/scene/timing.h"
 #include "volume/colormap.h"
 #include "volume/geometry.h"
+#include "volume/plan.h"
+#include "volume/point_query.h"
 #include "volume/readers.h"
 #include "volume/reduction.h"
 
@@ -210,7 +214,22 @@ Legend VolumeLayer::legend() const {
     if (!v->spec.visible || (v->spec.slices.empty() && v->spec.isosurfaces.empty())) continue;
     const std::string units = v->data.units.empty() ? "" : " (" + v->data.units + ")";
     legend.title = v->data.name + units;
-    if (!v->spec.slices.empty()) {
+    if (!v->spec.slices.empty() && volume::is_categorical(v->spec.slices.front().colormap)) {
+      // One swatch per category: the transmitters' names where the volume records them
+      // (best_server), else the whole numbers within the values' range (at most 64).
+      const std::vector<volume::RecordedTransmitter> tx = volume::recorded_transmitters(v->data);
+      const double first = tx.empty() ? std::ceil(static_cast<double>(v->range[0])) : 1.0;
+      const double last = tx.empty() ? std::min(std::floor(static_cast<double>(v->range[1])), first + 63.0) : static_cast<double>(tx.size());
+      for (double k = first; k <= last; k += 1.0) {
+        const glm::u8vec3 c = volume::category_color(static_cast<std::int64_t>(k));
+        legend.categories.push_back({tx.empty() ? std::to_string(static_cast<long long>(k))
+                                                : tx[static_cast<std::size_t>(k) - 1].name,
+                                     {c.r, c.g, c.b},
+                                     k});
+      }
+      legend.categories_title = tx.empty() ? "categories" : "transmitters";
+      legend.subtitle = slice_text(v->spec.slices.front()) + ": categorical";
+    } else if (!v->spec.slices.empty()) {
       const volume::SliceSpec& s = v->spec.slices.front();
       legend.lo = s.lo.value_or(v->range[0]);
       legend.hi = s.hi.value_or(v->range[1]);
@@ -226,6 +245,17 @@ Legend VolumeLayer::legend() const {
     break;
   }
   return legend;
+}
+
+std::vector<PointValue> VolumeLayer::values_at(double lat, double lon, double height_agl, double ground_m) const {
+  std::vector<PointValue> out;
+  for (const auto& v : volumes_) {
+    if (!v->spec.visible) continue;
+    const volume::PointQuery q(v->data);
+    out.push_back({v->spec.file.filename().string() + " " + v->data.name, v->data.units,
+                   q.value(lat, lon, height_agl, ground_m)});
+  }
+  return out;
 }
 
 }  // namespace terravol::app::scene

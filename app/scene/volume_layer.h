@@ -44,8 +44,18 @@ struct Legend {
   std::string colormap;  // volume::colormap_by_name; empty: no slice, no bar
   double lo = 0.0, hi = 1.0;
   std::vector<LegendLevel> levels;
+  // A categorical slice's swatches (value: the category), headed by categories_title.
+  std::vector<LegendLevel> categories;
+  std::string categories_title;  // "transmitters", "categories"
 
-  bool empty() const { return colormap.empty() && levels.empty(); }
+  bool empty() const { return colormap.empty() && levels.empty() && categories.empty(); }
+};
+
+// A volume's value at a point (VolumeLayer::values_at).
+struct PointValue {
+  std::string volume;  // the file's name, and the field
+  std::string units;
+  double value = 0;    // NaN outside the volume
 };
 
 class VolumeLayer {
@@ -84,8 +94,16 @@ class VolumeLayer {
   void set_isosurface(std::size_t volume, std::size_t iso, const volume::IsoSpec& spec);
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
-  // slice's range, and every isosurface level with its colour. Empty when there is none.
+  // slice's range, and every isosurface level with its colour; for a "categorical" slice no
+  // bar but a swatch per category (`categories`), labelled with the names of the transmitters
+  // the volume records (volume::recorded_transmitters: best_server), else with the whole
+  // numbers in the volume's range. Empty when there is none. Throws std::invalid_argument for
+  // a malformed "transmitters" attribute.
   Legend legend() const;
+
+  // Each visible volume's value at (lat, lon) and height_agl metres above the ground there,
+  // ground_m metres above the datum (volume::PointQuery: trilinear, NaN outside), in order.
+  std::vector<PointValue> values_at(double lat, double lon, double height_agl, double ground_m) const;
 
  private:
   struct Loaded;

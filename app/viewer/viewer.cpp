@@ -41,6 +41,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -66,6 +67,7 @@ const char* const kViewKeys =
     "R / F        up / down (also PageUp / PageDown)\n"
     "arrows       turn left / right, look up / down\n"
     "left drag    look around\n"
+    "Ctrl+click   the point under the cursor: lat, lon, ground, each volume's value\n"
     "Shift        4x faster; mouse wheel: speed x1.25 or /1.25\n"
     "+ / -        finer / coarser LOD (threshold / or x sqrt 2); or drag the slider\n"
     "M            LOD metric: screen-space error / projected area\n"
@@ -202,6 +204,7 @@ class Viewer {
   void key_press(const std::string& key);
   void key_release(const std::string& key);
   void button(bool down, int x, int y);
+  void pick(int x, int y);
   void mouse_move(int x, int y);
   void wheel(int clicks);
   void leave();
@@ -251,6 +254,7 @@ class Viewer {
   std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;  // slide_log_: this thread's part
   std::filesystem::path last_screenshot_;
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
+  std::optional<render::Pick> pick_;  // the last Ctrl-click's point (status file)
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
   bool layout_dirty_ = true;  // the text, the key list or the legend changed since lay_out()
   int layout_size_[2] = {0, 0};
@@ -286,7 +290,13 @@ class ViewerStyle : public vtkInteractorStyle {
   void OnChar() override {}
   void OnKeyPress() override { viewer_->key_press(key()); }
   void OnKeyRelease() override { viewer_->key_release(key()); }
-  void OnLeftButtonDown() override { viewer_->button(true, pos()[0], pos()[1]); }
+  void OnLeftButtonDown() override {
+    if (this->Interactor->GetControlKey() != 0) {
+      viewer_->pick(pos()[0], pos()[1]);
+    } else {
+      viewer_->button(true, pos()[0], pos()[1]);
+    }
+  }
   void OnLeftButtonUp() override { viewer_->button(false, pos()[0], pos()[1]); }
   void OnMouseMove() override { viewer_->mouse_move(pos()[0], pos()[1]); }
   void OnMouseWheelForward() override { viewer_->wheel(1); }
@@ -524,6 +534,25 @@ void Viewer::button(bool down, int x, int y) {
   dragging_ = down;
   drag_x_ = x;
   drag_y_ = y;
+}
+
+// The point under the cursor, in the overlay: where, the ground, and each visible volume's value.
+void Viewer::pick(int x, int y) {
+  pick_ = pipeline_->pick(x, y);
+  dirty_ = true;
+  if (!pick_) {
+    message_ = "pick: nothing under the cursor (sky, or beyond the window)";
+    return;
+  }
+  const io::Geodetic& g = pick_->point.where;
+  char b[256];
+  std::snprintf(b, sizeof b, "pick %.5f, %.5f on the %s: ground %.1f m, %.1f m above it (%.1f ms)", g.lat, g.lon,
+                pick_->point.on_surface ? "surface" : "terrain", pick_->ground, g.h - pick_->ground, pick_->ms);
+  message_ = b;
+  for (const scene::PointValue& v : pick_->values) {
+    std::snprintf(b, sizeof b, "\n  %s: %.2f %s", v.volume.c_str(), v.value, v.units.c_str());
+    message_ += b;
+  }
 }
 
 void Viewer::mouse_move(int x, int y) {
@@ -950,6 +979,16 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                 {"merge_ms", merge.merge_ms}};
   j["last_merge_ms"] = last_merge_ms_;
   j["message"] = message_;
+  if (pick_) {
+    const io::Geodetic& g = pick_->point.where;
+    ordered_json values = ordered_json::array();
+    for (const scene::PointValue& v : pick_->values) {
+      values.push_back({{"volume", v.volume}, {"value", std::isfinite(v.value) ? ordered_json(v.value) : ordered_json(nullptr)}});
+    }
+    j["pick"] = {{"lat", g.lat},       {"lon", g.lon},       {"height", g.h},
+                 {"ground", pick_->ground}, {"on_surface", pick_->point.on_surface}, {"ms", pick_->ms},
+                 {"values", values}};
+  }
   // Nothing will draw another frame until something happens: no key held, no slide read
   // ahead, no overlay refresh or screenshot due.
   j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_;

@@ -105,6 +105,37 @@ TEST_F(VolumeRender, SceneFilePathsAreRelativeToItAndOptionsOverrideIt) {
   EXPECT_EQ(b.height, 100);
 }
 
+// Two transmitters 8 km apart west and east (`terravol rf --tx A --tx B`), their best_server
+// drawn as an opaque categorical slice and seen from straight above, north up: the west half of
+// the image holds mostly the first transmitter's colour and the east half the second's (tab20's
+// blue and orange, written out here), and a continuous map shows neither.
+TEST_F(VolumeRender, BestServerSliceIsDrawnInEachTransmittersColourOnItsSide) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const std::string two = path("two.vdb").string();
+  const auto r = run_terravol("rf --quiet --tx 45.50,6.50,60,900,50,name=west --tx 45.50,6.60,60,900,50,name=east --dem " +
+                                  bundled_dem() + " --radius-km 6 --heights 0:400:100 -o " + two,
+                              120);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string view = " --camera 45.50,6.55,9000,0,-90 --size 300x200 --no-legend --volume " + two +
+                           " --field best_server --slice agl=100,opacity=1,colormap=";
+  const test::Image by_server = render(bundled_dem() + view + "categorical", "best_server");
+  const test::Image viridis = render(bundled_dem() + view + "viridis", "best_server_viridis");
+  ASSERT_EQ(by_server.width, 300);
+  const test::Rgb8 blue{31, 119, 180}, orange{255, 127, 14};
+  auto share = [](const test::Image& img, int x0, int x1, const test::Rgb8& c) {
+    std::size_t n = 0, all = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = x0; x < x1; ++x, ++all) n += test::same_color(img.at(x, y), c, 40);
+    return static_cast<double>(n) / static_cast<double>(all);
+  };
+  const int w = by_server.width, third = w / 3;
+  EXPECT_GT(share(by_server, 0, third, blue), 0.4);
+  EXPECT_LT(share(by_server, 0, third, orange), 0.1);
+  EXPECT_GT(share(by_server, w - third, w, orange), 0.4);
+  EXPECT_LT(share(by_server, w - third, w, blue), 0.1);
+  EXPECT_LT(share(viridis, 0, w, orange), 0.01);
+}
+
 TEST_F(VolumeRender, BadVolumesAndStylesFailWithOneLine) {
   const auto garbage = path("garbage.vdb");
   std::ofstream(garbage) << "not a vdb at all";

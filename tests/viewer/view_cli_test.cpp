@@ -615,6 +615,57 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
   EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
 
+// Ctrl+click picks the point under the cursor. Looking straight down, the window's centre
+// pixel is the camera's nadir: on the terrain, at the camera's latitude and longitude; the
+// volume's value there is what `terravol query` gives at that point. With a slice 300 m above
+// the ground in the way, the pick lands on it instead.
+TEST(ViewCli, CtrlClickPicksTheTerrainOrTheSliceInFrontAndShowsTheVolumesValue) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  ASSERT_TRUE(make_volume(vdb));
+  for (const bool with_slice : {false, true}) {
+    Viewer v(bundled_dem() + " --camera 45.51,6.52,6000,0,-90 --volume " + vdb.string() +
+             (with_slice ? " --slice agl=300" : "") + kSmall);
+    ASSERT_TRUE(v.start());
+    v.settle();
+    // The centre of the window: pixel (w/2 - 1/2, h/2 - 1/2) from the bottom is (w/2, h/2) here
+    // to within half a pixel, a few metres on the ground from 3 km up.
+    v.xdo("keydown ctrl");
+    v.xdo("mousemove --window " + v.window() + " " + std::to_string(v.width() / 2) + " " + std::to_string(v.height() / 2));
+    v.xdo("click 1");
+    v.xdo("keyup ctrl");
+    ASSERT_TRUE(v.wait_for([](const json& s) { return s.contains("pick"); }, 10.0)) << v.stderr_text();
+    const json p = v.status()["pick"];
+    EXPECT_NEAR(p["lat"].get<double>(), 45.51, 1e-4) << p;
+    EXPECT_NEAR(p["lon"].get<double>(), 6.52, 1.5e-4) << p;
+    const double agl = p["height"].get<double>() - p["ground"].get<double>();
+    EXPECT_EQ(p["on_surface"].get<bool>(), with_slice) << p;
+    if (with_slice) {
+      EXPECT_NEAR(agl, 300.0, 25.0) << p;  // the slice's sheet between its lattice columns
+    } else {
+      EXPECT_NEAR(agl, 0.0, 0.01) << p;
+    }
+    ASSERT_EQ(p["values"].size(), 1u) << p;
+    char at[96];
+    std::snprintf(at, sizeof at, "%.8f,%.8f,%.4f", p["lat"].get<double>(), p["lon"].get<double>(), agl);
+    const auto q = test::run_terravol("query --volume " + vdb.string() + " --dem " + bundled_dem() + " --at " + at);
+    ASSERT_EQ(q.status, 0) << q.err;
+    const std::string row = q.out.substr(q.out.find('\n') + 1);
+    const double expected = std::stod(row.substr(row.rfind(',') + 1));
+    EXPECT_NEAR(p["values"][0]["value"].get<double>(), expected, 1e-3) << p << "\n" << q.out;
+    // What the pick costs, and the frame that shows it in the overlay (for docs/rf-model.md).
+    const json shown = v.settle();
+    std::printf("pick on the %s: %.2f ms, then the frame %.1f ms\n", with_slice ? "slice" : "terrain", p["ms"].get<double>(),
+                shown["frame_ms"].get<double>());
+    const std::string message = shown["message"].get<std::string>();
+    EXPECT_EQ(message.rfind("pick ", 0), 0u) << message;
+    EXPECT_NE(message.find("rf.vdb path_loss_db: "), std::string::npos) << message;
+    v.xdo("key q");
+    EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+  }
+}
+
 // The overlay's parts as the status gives them: {x, y, w, h} in window pixels, or none.
 struct Part {
   std::string name;

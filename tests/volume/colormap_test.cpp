@@ -79,7 +79,7 @@ TEST(Colormap, UnknownNameListsTheKnownOnes) {
     FAIL() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
-                 "unknown colour map 'Viridis' (known: viridis, plasma, inferno, magma, turbo, coolwarm, jet, grey, gray)");
+                 "unknown colour map 'Viridis' (known: viridis, plasma, inferno, magma, turbo, coolwarm, jet, grey, gray, categorical)");
   }
   EXPECT_EQ(colormap_names().size(), 8u);
   for (const std::string& name : colormap_names()) EXPECT_NO_THROW(colormap_by_name(name));
@@ -131,6 +131,19 @@ TEST(Colormap, InterpolatesBetweenItsStops) {
       }
     }
   }
+}
+
+// Tableau 20 as matplotlib lists it (_tab20_data, here as its hex codes): darks first.
+TEST(CategoryColor, DarksThenLightsOfTab20CycledAfterTwenty) {
+  EXPECT_EQ(category_color(1), glm::u8vec3(0x1f, 0x77, 0xb4));
+  EXPECT_EQ(category_color(2), glm::u8vec3(0xff, 0x7f, 0x0e));
+  EXPECT_EQ(category_color(10), glm::u8vec3(0x17, 0xbe, 0xcf));
+  EXPECT_EQ(category_color(11), glm::u8vec3(0xae, 0xc7, 0xe8));
+  EXPECT_EQ(category_color(20), glm::u8vec3(0x9e, 0xda, 0xe5));
+  EXPECT_EQ(category_color(21), category_color(1));
+  EXPECT_EQ(category_color(0), category_color(20));
+  EXPECT_TRUE(is_categorical("categorical"));
+  EXPECT_THROW(colormap_by_name("categorical"), std::invalid_argument);
 }
 
 }  // namespace

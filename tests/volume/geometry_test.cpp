@@ -15,6 +15,7 @@
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "io/dem_file.h"
@@ -400,6 +401,41 @@ TEST(Slice, ColoursFollowTheMapAtKnownValues) {
   }
 }
 
+// A categorical slice (best_server) shows each vertex's nearest lattice value, never one
+// interpolated between two categories, in that category's colour: seeded indices 1..25 against
+// the nearest point found by rounding the vertex's lattice coordinates, and tab20's colours
+// written out here from matplotlib's hex codes (darks, then lights, cycled after 20).
+TEST(Slice, CategoricalShowsTheNearestLatticeValueInItsCategoryColour) {
+  const char* tab20[] = {"1f77b4", "ff7f0e", "2ca02c", "d62728", "9467bd", "8c564b", "e377c2",
+                         "7f7f7f", "bcbd22", "17becf", "aec7e8", "ffbb78", "98df8a", "ff9896",
+                         "c5b0d5", "c49c94", "f7b6d2", "c7c7c7", "dbdb8d", "9edae5"};
+  auto expected = [&](int k) {
+    const unsigned long rgb = std::stoul(tab20[(k - 1) % 20], nullptr, 16);
+    return glm::u8vec4((rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255, 255);
+  };
+  std::mt19937 rng(4242);
+  std::uniform_int_distribution<int> category(1, 25);
+  Scene s(geographic_volume({9, 7, 6}));
+  for (float& x : s.volume.values) x = static_cast<float>(category(rng));
+  const SliceSpec specs[] = {at(SliceKind::kLat, s.volume.lattice.world(1, 2.3)),
+                             at(SliceKind::kLon, s.volume.lattice.world(0, 5.8)),
+                             at(SliceKind::kAlt, s.volume.lattice.world(2, 1.6))};
+  for (SliceSpec spec : specs) {
+    spec.colormap = "categorical";
+    spec.opacity = 1.0;
+    const Mesh m = slice(s.volume, s.mapper, spec, {});
+    ASSERT_FALSE(m.empty());
+    for (std::size_t n = 0; n < m.vertices.size(); ++n) {
+      const glm::dvec3 q = lattice_of(s.volume, s.frame, m.vertices[n]);
+      const int k = static_cast<int>(
+          s.volume.values[s.volume.lattice.index(static_cast<int>(std::round(q.x)), static_cast<int>(std::round(q.y)),
+                                                 static_cast<int>(std::round(q.z)))]);
+      EXPECT_EQ(m.colors[n], expected(k)) << "vertex " << n << " at " << q.x << ", " << q.y << ", " << q.z;
+    }
+  }
+  EXPECT_EQ(parse_slice("agl=30,colormap=categorical").colormap, "categorical");
+}
+
 // Seeded linear fields are reproduced exactly by the trilinear interpolation (read through the
 // grey map, to within its 8-bit rounding).
 TEST(Slice, InterpolationIsExactOnLinearFields) {
@@ -597,7 +633,7 @@ TEST(Geometry, PropagationVolumeOverTheBundledDem) {
   grid.radius_km = 4.0;
   grid.spacing_arcsec = 9.0;
   grid.heights_agl = {0.0, 100.0, 200.0, 300.0, 400.0, 500.0};
-  const Volume v = compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 900.0, std::nullopt}, grid).path_loss;
+  const Volume v = compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}}, grid).path_loss;
   const GroundFunction ground = bilinear_ground(dem);
   const io::SceneFrame frame(45.5, 6.5);
   const LatticeMapper mapper(v, frame, ground);

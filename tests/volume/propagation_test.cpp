@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "io/mosaic.h"
+#include "volume_test_util.h"
 #include "io/scene_frame.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
@@ -18,21 +19,9 @@
 namespace terravol::volume {
 namespace {
 
-constexpr double kLambda900 = 299792458.0 / 900e6;
+using test::synthetic_dem;
 
-// A geographic 3" grid over 45..46 N, 6..7 E whose height is f(lat, lon).
-template <class F>
-io::Grid synthetic_dem(F f) {
-  io::Grid g;
-  g.format = "test";
-  g.allocate(1201, 1201);
-  g.georef.x0 = 6.0;
-  g.georef.y0 = 46.0;
-  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
-  for (int r = 0; r < g.rows; ++r)
-    for (int c = 0; c < g.cols; ++c) g.heights[g.index(r, c)] = static_cast<float>(f(46.0 - r / 1200.0, 6.0 + c / 1200.0));
-  return g;
-}
+constexpr double kLambda900 = 299792458.0 / 900e6;
 
 double geodesic_m(double lat1, double lon1, double lat2, double lon2) {
   double s = 0.0;
@@ -47,7 +36,7 @@ std::pair<int, int> tx_column(const Volume& v, const Transmitter& tx) {
           static_cast<int>(std::lround((tx.lat - l.origin[1]) / l.spacing[1]))};
 }
 
-const Transmitter kFlatTx{45.5, 6.5, 30.0, 900.0, std::nullopt};
+const Transmitter kFlatTx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
 
 TEST(FreeSpace, MatchesTheTextbookFormula) {
   for (double f : {30.0, 144.0, 900.0, 2400.0, 10000.0}) {
@@ -177,7 +166,7 @@ TEST(DiffractionProperty, SymmetricNonNegativeAndGrowingWithDepth) {
 
 TEST(Rf, FreeSpaceOverFlatGroundAtLineOfSight) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  Transmitter tx{45.5, 6.5, 200.0, 900.0, std::nullopt};
+  Transmitter tx{45.5, 6.5, 200.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 8.0;
   grid.spacing_arcsec = 30.0;
@@ -269,7 +258,7 @@ TEST(Rf, LossGrowsBehindARidge) {
 
 TEST(Rf, SignalIsEirpMinusPathLoss) {
   const io::Grid dem = synthetic_dem([](double lat, double lon) { return 500.0 + 300.0 * std::sin(40.0 * lat) * std::cos(50.0 * lon); });
-  const Transmitter tx{45.5, 6.5, 30.0, 450.0, 50.0};
+  const Transmitter tx{45.5, 6.5, 30.0, 450.0, 50.0, {}, {}};
   RfGrid grid;
   grid.radius_km = 5.0;
   grid.spacing_arcsec = 20.0;
@@ -283,12 +272,12 @@ TEST(Rf, SignalIsEirpMinusPathLoss) {
   for (std::size_t n = 0; n < r.path_loss.values.size(); ++n) {
     EXPECT_NEAR(r.signal->values[n], eirp - r.path_loss.values[n], 1e-4);
   }
-  EXPECT_FALSE(compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 450.0, std::nullopt}, grid).signal);
+  EXPECT_FALSE(compute_rf(dem, Transmitter{45.5, 6.5, 30.0, 450.0, std::nullopt, {}, {}}, grid).signal);
 }
 
 TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  const Transmitter centre{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  const Transmitter centre{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 20.0;
   grid.heights_agl = {};
@@ -305,7 +294,7 @@ TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
   EXPECT_TRUE(r.notes.empty());
   EXPECT_EQ(r.path_loss.frame, parse_frame("geographic-agl"));
 
-  const Transmitter corner{45.05, 6.03, 10.0, 900.0, std::nullopt};
+  const Transmitter corner{45.05, 6.03, 10.0, 900.0, std::nullopt, {}, {}};
   const RfResult c = compute_rf(flat, corner, grid);
   ASSERT_EQ(c.notes.size(), 1u);
   EXPECT_GE(c.path_loss.lattice.origin[0], 6.0);
@@ -317,7 +306,7 @@ TEST(Rf, LatticeIsCentredOnTheTransmitterAndClippedToTheDem) {
 
 TEST(Rf, RejectsBadParameters) {
   const io::Grid flat = synthetic_dem([](double, double) { return 0.0; });
-  const Transmitter tx{45.5, 6.5, 10.0, 900.0, std::nullopt};
+  const Transmitter tx{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}};
   RfGrid grid;
   grid.radius_km = 0.0;
   EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
@@ -325,10 +314,102 @@ TEST(Rf, RejectsBadParameters) {
   grid.heights_agl = {10.0, 20.0, 40.0};
   EXPECT_THROW(compute_rf(flat, tx, grid), std::invalid_argument);
   grid.heights_agl = {10.0};
-  EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt}, grid), std::invalid_argument);
-  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt}, grid), std::invalid_argument);
-  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{10.0, 10.0, 10.0, 900.0, std::nullopt, {}, {}}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, -5.0, std::nullopt, {}, {}}, grid), std::invalid_argument);
+  EXPECT_THROW(compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, 0.0, {}, {}}, grid), std::invalid_argument);
 }
+
+TEST(RfPath, EqualsComputeRfAtItsLatticePoints) {
+  const io::Grid dem = synthetic_dem([](double lat, double lon) { return 500.0 + 300.0 * std::sin(40.0 * lat) * std::cos(50.0 * lon); });
+  const Transmitter tx{45.5, 6.5, 30.0, 900.0, std::nullopt, {}, {}};
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 20.0;
+  grid.heights_agl = {0.0, 100.0, 200.0};
+  const Volume v = compute_rf(dem, tx, grid).path_loss;
+  std::mt19937 rng(1717);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int i = std::uniform_int_distribution<int>(0, v.lattice.dims[0] - 1)(rng);
+    const int j = std::uniform_int_distribution<int>(0, v.lattice.dims[1] - 1)(rng);
+    const int k = std::uniform_int_distribution<int>(0, 2)(rng);
+    const RfPath p = rf_path(dem, tx, v.lattice.world(1, j), v.lattice.world(0, i), v.lattice.world(2, k));
+    ASSERT_EQ(static_cast<float>(p.path_loss_db), v.at(i, j, k)) << i << " " << j << " " << k;
+    EXPECT_NEAR(p.path_loss_db, p.free_space_db + p.diffraction_db, 1e-9);
+    EXPECT_NEAR(p.diffraction_db, diffraction_loss_db(p.profile, 900.0), 1e-9);
+    double edges = 0.0;
+    for (std::size_t e = 0; e < p.edges.size(); ++e) {
+      edges += p.edges[e].loss_db;
+      if (e > 0) {
+        EXPECT_LT(p.edges[e - 1].sample, p.edges[e].sample);
+      }
+    }
+    EXPECT_NEAR(edges, p.diffraction_db, 1e-9);
+    EXPECT_LE(p.edges.size(), 3u);
+  }
+}
+
+TEST(RfPath, DepartureIsTheSteepestLegAboveTheTransmittersHorizon) {
+  // Over flat ground the path is clear: the departure is the line to the receiver, less the
+  // Earth's curvature, by hand: atan((h_rx - h_tx) / D) - atan(D / (2 k a)).
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  const Transmitter tx{45.5, 6.5, 40.0, 900.0, std::nullopt, {}, {}};
+  const RfPath clear = rf_path(flat, tx, 45.5, 6.6, 300.0);
+  ASSERT_TRUE(clear.edges.empty());
+  const double D = geodesic_m(45.5, 6.5, 45.5, 6.6);
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  EXPECT_NEAR(clear.departure_deg, (std::atan(260.0 / D) - std::atan(D / two_ka)) * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(clear.azimuth_deg, 90.0, 0.1);
+  // Behind a 400 m ridge 4 km east the path leaves towards the ridge's top, well above the
+  // line to a low receiver beyond it.
+  const io::Grid ridge = synthetic_dem([](double, double lon) { return lon >= 6.55 && lon <= 6.56 ? 400.0 : 0.0; });
+  const RfPath behind = rf_path(ridge, tx, 45.5, 6.65, 10.0);
+  ASSERT_FALSE(behind.edges.empty());
+  const std::size_t e = behind.edges.front().sample;
+  const double d = behind.profile.d_m[e], Db = behind.profile.distance_m;
+  const double raised = behind.profile.z_m[e] + d * (Db - d) / two_ka;
+  EXPECT_NEAR(behind.departure_deg, (std::atan((raised - 40.0) / d) - std::atan(Db / two_ka)) * 180.0 / M_PI, 1e-9);
+  EXPECT_GT(behind.departure_deg, 4.0);
+}
+
+// Over flat ground every path is clear, so with either model the departure is the line to the
+// receiver, and the pattern's attenuation is the model's loss with it less the loss without.
+void expect_pattern_attenuation_along_the_departure(const RfOptions& options) {
+  const io::Grid flat = synthetic_dem([](double, double) { return 100.0; });
+  Transmitter tx{45.5, 6.5, 40.0, 900.0, 10.0, {}, {}};
+  AntennaPattern pattern;
+  pattern.azimuth = parse_az("0\n0 1\n90 0.5\n180 0.1\n270 0.5\n", "t.az").first;
+  pattern.elevation = parse_el("0 0\n-10 1\n0 1\n10 0.2\n", "t.el").cut;
+  RfGrid grid;
+  grid.radius_km = 3.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {10.0, 510.0};
+  const Volume plain = compute_rf(flat, tx, grid, options).path_loss;
+  tx.antenna = pattern;
+  const RfResult with = compute_rf(flat, tx, grid, options);
+  EXPECT_NE(with.path_loss.attributes.at("antenna_pattern").find("t.az:t.el"), std::string::npos);
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  const Lattice& l = plain.lattice;
+  int checked = 0;
+  for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < l.dims[1]; ++j) {
+      for (int i = 0; i < l.dims[0]; ++i) {
+        double D = 0.0, azi1 = 0.0, azi2 = 0.0;
+        GeographicLib::Geodesic::WGS84().Inverse(45.5, 6.5, l.world(1, j), l.world(0, i), D, azi1, azi2);
+        if (D < 1.0) continue;
+        // Flat ground, clear paths: the departure is the line to the receiver (by hand).
+        const double departure = (std::atan((l.world(2, k) - 40.0) / D) - std::atan(D / two_ka)) * 180.0 / M_PI;
+        const double gain = pattern.gain_db(azi1 < 0.0 ? azi1 + 360.0 : azi1, departure);
+        EXPECT_NEAR(with.path_loss.at(i, j, k) - plain.at(i, j, k), -gain, 2e-4) << i << " " << j << " " << k;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+  // The signal follows: ERP in the pattern's strongest direction, less the pattern elsewhere.
+  EXPECT_NEAR(with.signal->values[5] + with.path_loss.values[5], 10.0 * std::log10(10.0) + 30.0 + 2.15, 1e-3);
+}
+
+TEST(RfPath, AntennaPatternAddsItsAttenuationAlongTheDeparture) { expect_pattern_attenuation_along_the_departure({}); }
 
 RfOptions itm_options() {
   RfOptions o;
@@ -340,7 +421,7 @@ RfOptions itm_options() {
 io::Grid hilly_dem() {
   return synthetic_dem([](double lat, double lon) { return 800.0 + 250.0 * std::sin(30.0 * lat) * std::cos(45.0 * lon); });
 }
-const Transmitter kHillyTx{45.5, 6.5, 20.0, 450.0, std::nullopt};
+const Transmitter kHillyTx{45.5, 6.5, 20.0, 450.0, std::nullopt, {}, {}};
 
 TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
   const io::Grid dem = hilly_dem();
@@ -367,6 +448,45 @@ TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
       EXPECT_FLOAT_EQ(v.at(i, j, k), static_cast<float>(expected.loss_db)) << i << " " << j << " " << k;
     }
   }
+}
+
+TEST(RfItm, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
+  expect_pattern_attenuation_along_the_departure(itm_options());
+}
+
+// rf_path with ITM is compute_rf's value at the lattice point, its terms add up, it has no
+// knife edges, and its departure is the steepest line over the profile (by hand from the
+// profile it returns: the terrain raised by the k-factor bulge).
+TEST(RfItm, PathEqualsComputeRfAndDepartsAlongTheSteepestLineOverTheTerrain) {
+  const io::Grid dem = hilly_dem();
+  const Transmitter tx = kHillyTx;
+  RfGrid grid;
+  grid.radius_km = 6.0;
+  grid.spacing_arcsec = 30.0;
+  grid.heights_agl = {2.0, 102.0};
+  const RfOptions o = itm_options();
+  const Volume v = compute_rf(dem, tx, grid, o).path_loss;
+  const double two_ka = 2.0 * 4.0 / 3.0 * 6371000.0;
+  std::mt19937 rng(1919);
+  int checked = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int i = std::uniform_int_distribution<int>(0, v.lattice.dims[0] - 1)(rng);
+    const int j = std::uniform_int_distribution<int>(0, v.lattice.dims[1] - 1)(rng);
+    const int k = std::uniform_int_distribution<int>(0, 1)(rng);
+    if (std::isnan(v.at(i, j, k))) continue;  // the transmitter's column
+    const RfPath p = rf_path(dem, tx, v.lattice.world(1, j), v.lattice.world(0, i), v.lattice.world(2, k), o);
+    ASSERT_EQ(static_cast<float>(p.path_loss_db), v.at(i, j, k)) << i << " " << j << " " << k;
+    EXPECT_TRUE(p.edges.empty());
+    EXPECT_NEAR(p.path_loss_db, p.free_space_db + p.diffraction_db, 1e-9);
+    const PathProfile& q = p.profile;
+    double slope = (q.rx_height_m - q.tx_height_m) / q.distance_m;
+    for (std::size_t m = 0; m < q.d_m.size(); ++m) {
+      slope = std::max(slope, (q.z_m[m] + q.d_m[m] * (q.distance_m - q.d_m[m]) / two_ka - q.tx_height_m) / q.d_m[m]);
+    }
+    EXPECT_NEAR(p.departure_deg, (std::atan(slope) - std::atan(q.distance_m / two_ka)) * 180.0 / M_PI, 1e-9);
+    ++checked;
+  }
+  EXPECT_GT(checked, 50);
 }
 
 TEST(Rf, DiscLeavesTheColumnsBeyondTheRadiusNaNAndTheOthersAsTheBox) {
@@ -431,21 +551,21 @@ TEST(RfItm, RejectsParametersOutsideTheModelsRange) {
     return std::string();
   };
   RfOptions o = itm_options();
-  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 10.0, std::nullopt}, grid, o),
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 10.0, std::nullopt, {}, {}}, grid, o),
             "ITM frequency 10 MHz: must be within [20, 20000] MHz");
-  EXPECT_EQ(message(Transmitter{45.5, 6.5, 0.2, 900.0, std::nullopt}, grid, o),
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 0.2, 900.0, std::nullopt, {}, {}}, grid, o),
             "transmitter height 0.2: ITM takes antenna heights within [0.5, 3000] m above ground");
   RfGrid low = grid;
   low.heights_agl = {0.0, 50.0};
-  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, low, o),
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, low, o),
             "height 0: ITM takes antenna heights within [0.5, 3000] m above ground");
   o.itm.climate = static_cast<ItmClimate>(0);
-  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, grid, o).rfind("ITM climate 0: must be within 1..7", 0), 0u);
+  EXPECT_EQ(message(Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, grid, o).rfind("ITM climate 0: must be within 1..7", 0), 0u);
   // The default heights start at 10 m for ITM, 0 for Deygout.
   RfGrid defaults;
   defaults.radius_km = 1.0;
   defaults.spacing_arcsec = 30.0;
-  const Lattice l = compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt}, defaults, itm_options()).path_loss.lattice;
+  const Lattice l = compute_rf(flat, Transmitter{45.5, 6.5, 10.0, 900.0, std::nullopt, {}, {}}, defaults, itm_options()).path_loss.lattice;
   EXPECT_EQ(l.dims[2], 41);
   EXPECT_EQ(l.world(2, 0), 10.0);
   EXPECT_EQ(l.world(2, 40), 2010.0);
@@ -458,7 +578,7 @@ TEST(Rf, WritesAVdbThatReadsBackBothGrids) {
   grid.radius_km = 3.0;
   grid.spacing_arcsec = 15.0;
   grid.heights_agl = {0.0, 100.0, 200.0};
-  const RfResult r = compute_rf(mosaic, Transmitter{45.5, 6.5, 30.0, 900.0, 50.0}, grid);
+  const RfResult r = compute_rf(mosaic, Transmitter{45.5, 6.5, 30.0, 900.0, 50.0, {}, {}}, grid);
   EXPECT_EQ(r.path_loss.attributes.at("dem"), "N45E006.hgt");
   EXPECT_EQ(r.path_loss.attributes.at("tx_lat"), "45.5");
   const std::string bytes = encode_vdb({&r.path_loss, &*r.signal});

@@ -3,8 +3,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <vector>
 #include <string>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "temp_dir.h"
 #include "volume/readers.h"
@@ -12,17 +16,9 @@
 namespace terravol::volume {
 namespace {
 
+using test::bundled_dem;
+using test::expect_one_line_error;
 using test::run_terravol;
-
-std::string bundled_dem() { return std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"; }
-
-void expect_one_line_error(const test::CommandResult& r, const std::string& prefix) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-  EXPECT_LT(r.seconds, 5.0);
-}
 
 TEST(RfCli, DefaultRunOnTheBundledDemWritesAReadableVdb) {
   test::TempDir dir;
@@ -109,6 +105,92 @@ TEST(RfCli, BadOptionsFailWithOneLine) {
       {"--model itm --tx 45.5,6.5,30 --k-factor 1.2" + dem + out, "--k-factor: only with --model deygout"},
       {"--tx 45.5,6.5,30 --climate 5" + dem + out, "--climate: only with --model itm"},
       {"--tx 45.5,6.5,30 --dem " + (dir.path() / "N00E000.hgt").string() + out, (dir.path() / "N00E000.hgt").string()},
+  };
+  for (const auto& [args, prefix] : cases) {
+    SCOPED_TRACE(args);
+    expect_one_line_error(run_terravol("rf " + args), prefix);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.vdb"));
+}
+
+TEST(RfCli, SeveralTransmittersWriteEachSignalAndTheBestServer) {
+  test::TempDir dir;
+  const auto out = dir.path() / "plan.vdb";
+  const auto file = dir.path() / "sites.txt";
+  std::ofstream(file) << "# two more sites\n45.45,6.55,20,900,10,name=south\n\n  45.52,6.45,25,900,20\n";
+  const auto r = run_terravol("rf --tx 45.5,6.5,30,900,50,name=peak --tx-file " + file.string() + " --dem " +
+                              bundled_dem() + " --radius-km 4 --heights 10:110:50 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("3 transmitters"), std::string::npos) << r.out;
+  const auto grids = [&] {
+    std::ifstream in(out, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return vdb_grids(bytes, out.string());
+  }();
+  std::vector<std::string> names;
+  for (const auto& g : grids) names.push_back(g.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"signal_dbm_peak", "signal_dbm_south", "signal_dbm_tx3", "best_signal_dbm",
+                                             "best_server"}));
+  ReadOptions o;
+  o.field = "signal_dbm_peak";
+  const Volume peak = read_volume(out, o);
+  // The first transmitter's signal is what rf gives it alone.
+  const auto alone = dir.path() / "alone.vdb";
+  ASSERT_EQ(run_terravol("rf --tx 45.5,6.5,30,900,50 --dem " + bundled_dem() + " --radius-km 4 --heights 10:110:50 -o " +
+                         alone.string()).status, 0);
+  o.field = "signal_dbm";
+  const Volume single = read_volume(alone, o);
+  EXPECT_EQ(peak.lattice, single.lattice);
+  EXPECT_EQ(peak.values, single.values);
+  o.field = "best_server";
+  const Volume server = read_volume(out, o);
+  EXPECT_EQ(server.attributes.at("transmitters").substr(0, 5), "peak,");
+  std::size_t counts[4] = {0, 0, 0, 0};
+  for (const float s : server.values) counts[std::isnan(s) ? 0 : static_cast<int>(s)]++;
+  for (int t = 1; t <= 3; ++t) EXPECT_GT(counts[t], 1000u) << t;
+  EXPECT_GT(counts[0], 0u);  // corners of the union no box holds
+}
+
+TEST(RfCli, AntennaPatternInTheTransmitter) {
+  test::TempDir dir;
+  std::ofstream(dir.path() / "s.az") << "0\n0 1\n90 0.3\n180 0.05\n270 0.3\n";
+  const auto out = dir.path() / "p.vdb", plain = dir.path() / "q.vdb";
+  const std::string tx = "45.5,6.5,30,900,50";
+  ASSERT_EQ(run_terravol("rf --tx " + tx + ",pattern=" + (dir.path() / "s.az").string() + ",azimuth=90 --dem " +
+                         bundled_dem() + " --radius-km 3 --heights 10 -o " + out.string()).status, 0);
+  ASSERT_EQ(run_terravol("rf --tx " + tx + " --dem " + bundled_dem() + " --radius-km 3 --heights 10 -o " + plain.string()).status, 0);
+  const Volume a = read_volume(out), b = read_volume(plain);
+  ASSERT_EQ(a.lattice, b.lattice);
+  EXPECT_NE(a.attributes.at("antenna_pattern").find("rotation 90"), std::string::npos);
+  // Pointed east: east of the mast the loss is (nearly) as without; west it is 26 dB more.
+  const int j = a.lattice.dims[1] / 2;
+  EXPECT_NEAR(a.at(a.lattice.dims[0] - 1, j, 0) - b.at(a.lattice.dims[0] - 1, j, 0), 0.0, 0.5);
+  EXPECT_NEAR(a.at(0, j, 0) - b.at(0, j, 0), -20.0 * std::log10(0.05), 0.5);
+}
+
+TEST(RfCli, BadTransmittersFailWithOneLine) {
+  test::TempDir dir;
+  const std::string dem = " --dem " + bundled_dem();
+  const std::string out = " -o " + (dir.path() / "x.vdb").string();
+  const auto file = dir.path() / "sites.txt";
+  std::ofstream(file) << "45.5,6.5,30,900,5\n45.5,abc,30\n";
+  std::ofstream(dir.path() / "bad.az") << "0\n0 1\n90 2\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--tx 45.5,6.5,30,color=red" + dem + out, "--tx 45.5,6.5,30,color=red: unknown field 'color'"},
+      {"--tx 45.5,6.5,30,name=a,name=b" + dem + out, "--tx 45.5,6.5,30,name=a,name=b: name given twice"},
+      {"--tx 45.5,6.5,30,name=a/b" + dem + out, "--tx 45.5,6.5,30,name=a/b: name 'a/b': 1 to 32"},
+      {"--tx 45.5,6.5,30,tilt=3" + dem + out, "--tx 45.5,6.5,30,tilt=3: tilt needs pattern="},
+      {"--tx 45.5,6.5,30,name=a,900" + dem + out, "--tx 45.5,6.5,30,name=a,900: '900': numbers come first"},
+      {"--tx 45.5,6.5,30,pattern=" + (dir.path() / "bad.az").string() + dem + out,
+       "--tx 45.5,6.5,30,pattern=" + (dir.path() / "bad.az").string() + ": " + (dir.path() / "bad.az").string() +
+           ": line 3: field 2 is outside [0, 1]"},
+      {"--tx 45.5,6.5,30,900,5 --tx 45.4,6.5,30" + dem + out, "transmitter tx2: several transmitters need an ERP each"},
+      {"--tx 45.5,6.5,30,900,5,name=a --tx 45.4,6.5,30,900,5,name=a" + dem + out, "transmitter name a is given twice"},
+      {"--tx-file " + file.string() + dem + out, file.string() + ": line 2: longitude 'abc' is not a number"},
+      {"--tx-file " + (dir.path() / "none.txt").string() + dem + out, (dir.path() / "none.txt").string() + ": cannot read"},
+      {"--tx 45.5,6.5,30,900,5 --tx 10,10,30,900,5" + dem + out, "transmitter tx2: the transmitter lies outside the DEM"},
+      {dem + out, "give the transmitters: --tx (once or more) or --tx-file"},
+      {"--tx 45.5,6.5,30 --threads -1" + dem + out, "--threads -1: must be within [0, 1024]"},
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);

@@ -4,31 +4,29 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "cli_test_util.h"
 #include "run_command.h"
 #include "shared_data.h"
 #include "temp_dir.h"
+#include "volume/compare.h"
 #include "volume/readers.h"
 #include "volume/vdb_write.h"
+#include "volume_test_util.h"
 
 namespace terravol::volume {
 namespace {
 
+using test::expect_one_line_error;
 using test::run_terravol;
 
 const char kSplat[] = "/usr/bin/splat";
-
-void expect_one_line_error(const test::CommandResult& r, const std::string& prefix) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(r.err.rfind("terravol: " + prefix, 0), 0u) << r.err;
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-}
 
 void write(const std::filesystem::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
@@ -131,6 +129,47 @@ TEST(SplatCli, RunsSplatOnTheUtahTilesImportsItsOutputAndCompares) {
   EXPECT_GT(pearson, 0.5) << cmp.out;
 }
 
+// The same antenna pattern in SPLAT! (splat-volume passes it on) and in the built-in model: the
+// attenuation each applies (loss with the pattern minus loss without) over SPLAT!'s disc.
+// Azimuth dominates and both apply it alike; the elevation cut is applied at each model's own
+// departure angle (SPLAT!: the first terrain above the line of sight; the built-in model: its
+// steepest knife edge), so the two differ where the tilted beam's edge falls between them.
+TEST(SplatCli, SameAntennaPatternInSplatAndInTheBuiltInModel) {
+  const auto tiles = test::shared_dem("utah_sdf");
+  TERRAVOL_REQUIRE_SHARED(tiles);
+  if (!std::filesystem::exists(kSplat)) GTEST_SKIP() << kSplat << " not found (Debian package splat)";
+  test::TempDir dir;
+  const auto [az, el] = test::smooth_sector_texts();
+  write(dir.path() / "s.az", az);
+  write(dir.path() / "s.el", el);
+  // Farnsworth Peak, pointed north-east and tilted down 3 degrees.
+  const std::string site = "40.6589,-112.2019,30,900,50";
+  const std::string pattern = ",pattern=" + (dir.path() / "s.az").string() + ":" + (dir.path() / "s.el").string() + ",azimuth=60,tilt=3";
+  const std::string box = " --heights 10 --radius-km 8 -o ";
+  auto run = [&](const std::string& command, const std::string& name) {
+    const auto r = run_terravol(command + box + (dir.path() / name).string(), 60);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return read_volume(dir.path() / name);
+  };
+  const Volume splat_with = run("splat-volume --tx " + site + pattern + " --sdf " + tiles.string(), "sw.vdb");
+  const Volume splat_without = run("splat-volume --tx " + site + " --sdf " + tiles.string(), "so.vdb");
+  const Volume rf_with = run("rf --tx " + site + pattern + " --dem " + tiles.string(), "rw.vdb");
+  const Volume rf_without = run("rf --tx " + site + " --dem " + tiles.string(), "ro.vdb");
+  EXPECT_NE(splat_with.attributes.at("antenna_pattern").find("rotation 60, tilt 3"), std::string::npos);
+  auto attenuation = [](const Volume& with, const Volume& without) {
+    EXPECT_EQ(with.lattice, without.lattice);
+    Volume d = with;
+    for (std::size_t n = 0; n < d.values.size(); ++n) d.values[n] = with.values[n] - without.values[n];
+    return d;
+  };
+  const Comparison c = compare_volumes(attenuation(rf_with, rf_without), attenuation(splat_with, splat_without));
+  std::printf("pattern attenuation, rf vs SPLAT!: %zu points, r = %.3f, median |difference| %.2f dB, medians %.2f / %.2f dB\n",
+              c.all.points, c.all.pearson, c.all.median_abs_difference, c.all.median_a, c.all.median_b);
+  EXPECT_GT(c.all.points, 20000u);
+  EXPECT_GT(c.all.pearson, 0.95);
+  EXPECT_LT(c.all.median_abs_difference, 0.5);
+}
+
 // SPLAT!'s own ITM (-olditm) against the built-in one on SPLAT!'s own profiles (--check-itm)
 // and on the same 3" lattice, on a small disc every run. docs/rf-model.md has the 20 km, 31-height comparison (r >= 0.98 at every height).
 // Within 8 km a larger share of the points is near the transmitter, where SPLAT! evaluates
@@ -193,6 +232,7 @@ TEST(SplatCli, BadOptionsFailWithOneLine) {
   const auto bad_ano = dir.path() / "bad.ano";
   write(bad_ano, "113, 111\n41, 40\n40.5, 111.5, 1, 2\n");
   const std::string t = " --tx 40.5,-111.5,30";
+  write(dir.path() / "s.az", test::smooth_sector_texts().first);
   const std::pair<std::string, std::string> cases[] = {
       {out, "give the transmitter (--tx or --qth) and --sdf, or --import -ano files"},
       {t + out, "--sdf: the folder of SDF tiles is required"},
@@ -224,6 +264,8 @@ TEST(SplatCli, BadOptionsFailWithOneLine) {
       {" --import " + bad_ano.string() + " --olditm --heights 10" + out, "--olditm: not used with --import"},
       {" --import " + bad_ano.string() + " --check-itm --heights 10" + out, "--check-itm: needs a SPLAT! run with --olditm"},
       {t + sdf + " --check-itm" + out, "--check-itm: needs a SPLAT! run with --olditm (not --import)"},
+      {t + ",900,50,pattern=" + (dir.path() / "s.az").string() + sdf + " --olditm --check-itm" + out,
+       "--check-itm: compares the ITM alone, without an antenna pattern in --tx"},
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);

@@ -5,17 +5,51 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "io/error.h"
+#include "io/grid.h"
 #include "temp_dir.h"
 #include "volume/volume.h"
 
 namespace terravol::test {
+
+// A geographic 3" grid over 45..46 N, 6..7 E whose height is f(lat, lon) at every sample.
+template <class F>
+io::Grid synthetic_dem(F f) {
+  io::Grid g;
+  g.format = "test";
+  g.allocate(1201, 1201);
+  g.georef.x0 = 6.0;
+  g.georef.y0 = 46.0;
+  g.georef.dx = g.georef.dy = 1.0 / 1200.0;
+  for (int r = 0; r < g.rows; ++r)
+    for (int c = 0; c < g.cols; ++c) g.heights[g.index(r, c)] = static_cast<float>(f(46.0 - r / 1200.0, 6.0 + c / 1200.0));
+  return g;
+}
+
+// A smooth sector antenna as SPLAT!'s .az and .el texts: in azimuth a cardioid, field 0.05 + 0.95
+// ((1 + cos a) / 2)^2, every 5 degrees; in elevation a beam whose field is cos(4 x depression),
+// at least 0.1, every 0.5 degree from -10 to 90; rotation 0, no tilt.
+inline std::pair<std::string, std::string> smooth_sector_texts() {
+  std::string az = "0\n", el = "0 0\n";
+  for (int a = 0; a < 360; a += 5) {
+    const double c = 0.5 + 0.5 * std::cos(a * M_PI / 180.0);
+    az += std::to_string(a) + " " + std::to_string(0.05 + 0.95 * c * c) + "\n";
+  }
+  for (int i = -20; i <= 180; ++i) {
+    const double e = i / 2.0;
+    el += std::to_string(e) + " " + std::to_string(std::max(0.1, std::cos(std::min(80.0, std::abs(e) * 4.0) * M_PI / 180.0))) + "\n";
+  }
+  return {az, el};
+}
 
 // A volume of random values, fixed by the seed.
 inline volume::Volume random_volume(unsigned seed, std::array<int, 3> dims, volume::VolumeFrame frame) {
