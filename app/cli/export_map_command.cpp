@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "io/geotiff_write.h"
 #include "io/kmz_write.h"
 #include "io/mosaic.h"
+#include "volume/plan.h"
 #include "volume/readers.h"
 #include "volume/surface_raster.h"
 
@@ -88,9 +90,11 @@ void run_export_map(const ExportMapOptions& o) {
   if (!kmz && (!o.colormap.empty() || !o.range.empty())) {
     throw std::runtime_error("--colormap and --range colour a .kmz; a GeoTIFF holds the values themselves");
   }
+  const bool categorical = volume::is_categorical(o.colormap);
+  if (categorical && !o.range.empty()) throw std::runtime_error("--range: a categorical map colours each index, it has no range");
   const volume::Colormap colormap = [&] {
     try {
-      return volume::colormap_by_name(o.colormap.empty() ? "viridis" : o.colormap);
+      return volume::colormap_by_name(o.colormap.empty() || categorical ? "viridis" : o.colormap);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error("--colormap " + o.colormap + ": " + e.what());
     }
@@ -165,14 +169,32 @@ void run_export_map(const ExportMapOptions& o) {
     map.south = raster.south();
     map.west = raster.west;
     map.east = raster.east();
-    map.overlay_png = output::overlay_png(raster, colormap, lo, hi);
-    map.legend_png = output::legend_png(colormap, {v.name + units, where, lo, hi});
+    if (categorical) {
+      // One swatch per category present, named after the transmitter the volume records for it.
+      const std::vector<volume::RecordedTransmitter> tx = volume::recorded_transmitters(v);
+      std::set<std::int64_t> present;
+      for (const float x : raster.values)
+        if (std::isfinite(x)) present.insert(std::llround(x));
+      std::vector<output::MapCategory> categories;
+      for (const std::int64_t k : present) {
+        const bool named = k >= 1 && static_cast<std::size_t>(k) <= tx.size();
+        categories.push_back({k, named ? tx[static_cast<std::size_t>(k) - 1].name : std::to_string(k)});
+      }
+      map.description = description + "; colours: one per category (tab20)";
+      map.overlay_png = output::category_overlay_png(raster);
+      map.legend_png = output::category_legend_png(v.name, where, tx.empty() ? "categories" : "transmitters", categories);
+    } else {
+      map.overlay_png = output::overlay_png(raster, colormap, lo, hi);
+      map.legend_png = output::legend_png(colormap, {v.name + units, where, lo, hi});
+    }
     bytes = io::encode_kmz(map);
   } else {
     bytes = io::encode_geotiff(raster, {description, v.units});
   }
   output::write_file_atomically(o.output, bytes, o.force);
-  const std::string colours = kmz ? ", coloured " + std::string(colormap.name()) + " over " + fmt(lo) + " .. " + fmt(hi) : "";
+  const std::string colours = !kmz         ? ""
+                              : categorical ? ", coloured by category"
+                                            : ", coloured " + std::string(colormap.name()) + " over " + fmt(lo) + " .. " + fmt(hi);
   std::printf("%s: %d x %d pixels of %.4g\" x %.4g\", %.6f .. %.6f N, %.6f .. %.6f E; %zu with values, %g .. %g%s%s\n",
               out.c_str(), raster.cols, raster.rows, raster.dlon * 3600.0, raster.dlat * 3600.0, raster.south(),
               raster.north, raster.west, raster.east(), filled, vmin, vmax, units.c_str(), colours.c_str());
@@ -194,7 +216,7 @@ void add_export_map_command(CLI::App& app) {
   cmd->add_option("--dem", o->dems,
                   "DEM files or folders (one mosaic): the ground, needed when the surface's height is measured from "
                   "another reference than the volume's (--agl on a volume above the datum, --alt on a terrain-following one)");
-  cmd->add_option("--colormap", o->colormap, "KMZ only: the colour map (viridis, plasma, inferno, magma, turbo, coolwarm, jet, grey)");
+  cmd->add_option("--colormap", o->colormap, "KMZ only: the colour map (viridis, plasma, inferno, magma, turbo, coolwarm, jet, grey), or categorical for index fields such as best_server");
   cmd->add_option("--range", o->range, "KMZ only: LO:HI, the values at the colour map's ends; default: the map's minimum and maximum");
   cmd->add_option("-o,--output", o->output, "OUT.tif (or .tiff) or OUT.kmz")->required();
   cmd->add_flag("--force", o->force, "Replace an existing output file");

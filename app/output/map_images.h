@@ -16,6 +16,18 @@ namespace terravol::app::output {
 std::vector<std::uint8_t> overlay_png(const io::GeoRaster& raster, const volume::Colormap& colormap, double lo,
                                       double hi);
 
+// A categorical map (best_server, volume::is_categorical): each value rounded to its category
+// k, coloured volume::category_color(k), opaque; NaN transparent. PNG.
+std::vector<std::uint8_t> category_overlay_png(const io::GeoRaster& raster);
+
+// A swatch per category (value k, its label), in the legend card, no bar. Throws as legend_png.
+struct MapCategory {
+  std::int64_t k = 0;
+  std::string label;
+};
+std::vector<std::uint8_t> category_legend_png(const std::string& title, const std::string& subtitle,
+                                              const std::string& entries_title, const std::vector<MapCategory>& categories);
+
 struct MapLegend {
   std::string title;     // first line, bold, e.g. "path_loss_db (dB)"
   std::string subtitle;  // second line, e.g. "10 m above ground"; empty: none

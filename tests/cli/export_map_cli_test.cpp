@@ -237,6 +237,58 @@ TEST_F(ExportMapCli, KmzUnzipsToAKmlWhoseBoxMatchesTheGeoTiffAndAColourMappedOve
   EXPECT_GT(legend.height, 200);
 }
 
+// The best server of a two-transmitter plan (terravol rf on the bundled DEM): the GeoTIFF holds
+// the indices, and the KMZ colours each pixel of index k with tab20's k-th colour (written out
+// here by hand), with one swatch per transmitter.
+TEST_F(ExportMapCli, BestServerMapsKeepTheIndicesAndColourEachServerByCategory) {
+  const std::string dem = std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt";
+  const std::string plan = path("plan.vdb");
+  const auto rf = run_terravol("rf --quiet --dem " + dem +
+                                   " --tx 45.50,6.45,30,900,50 --tx 45.50,6.55,30,900,50 --radius-km 3 --heights 0:200:100 -o " + plan,
+                               300);
+  ASSERT_EQ(rf.status, 0) << rf.err;
+  ASSERT_EQ(run_terravol("export-map --volume " + plan + " --field best_server --agl 100 -o " + path("bs.tif")).status, 0);
+  const auto r = run_terravol("export-map --volume " + plan + " --field best_server --agl 100 --colormap categorical -o " +
+                              path("bs.kmz"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const test::GeoTiffContents tif = test::read_geotiff_file(path("bs.tif"));
+  const auto files = unzip_all(path("bs.kmz"));
+  ASSERT_TRUE(files.count("files/overlay.png") && files.count("files/legend.png"));
+  const test::Image image = test::decode_png(files.at("files/overlay.png"));
+  ASSERT_EQ(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), tif.values.size());
+  const int tab20[3][3] = {{0, 0, 0}, {0x1f, 0x77, 0xb4}, {0xff, 0x7f, 0x0e}};
+  std::size_t counts[3] = {0, 0, 0};
+  for (std::size_t p = 0; p < tif.values.size(); ++p) {
+    const float v = tif.values[p];
+    if (std::isnan(v)) {
+      EXPECT_EQ(image.alpha[p], 0) << p;
+      continue;
+    }
+    ASSERT_TRUE(v == 1.0f || v == 2.0f) << "an index, not " << v;
+    const int k = static_cast<int>(v);
+    ++counts[k];
+    EXPECT_EQ(image.alpha[p], 255) << p;
+    for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(image.pixels[p][ch], tab20[k][ch]) << p;
+  }
+  EXPECT_GT(counts[1], 100u) << "the western transmitter serves the west";
+  EXPECT_GT(counts[2], 100u) << "the eastern transmitter serves the east";
+  // West of the middle meridian the western one wins more often, east of it the eastern one.
+  std::size_t west_by_1 = 0, west_by_2 = 0;
+  for (int row = 0; row < image.height; ++row)
+    for (int col = 0; col < image.width / 3; ++col) {
+      const float v = tif.values[static_cast<std::size_t>(row) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(col)];
+      west_by_1 += v == 1.0f;
+      west_by_2 += v == 2.0f;
+    }
+  EXPECT_GT(west_by_1, west_by_2);
+  EXPECT_GT(test::decode_png(files.at("files/legend.png")).height, 40);
+  EXPECT_NE(run_terravol("export-map --volume " + plan + " --field best_server --agl 100 --colormap categorical --range 0:3 -o " +
+                         path("x.kmz"))
+                .status,
+            0)
+      << "a categorical map has no range";
+}
+
 // Bad input: one line naming the option or file, exit status 1 (2 for CLI11's own checks),
 // and nothing written.
 TEST_F(ExportMapCli, BadInputFailsWithOneLineAndWritesNothing) {
