@@ -152,6 +152,25 @@ TEST_F(ExportMapCli, GeoTiffOfATerrainFollowingVolumeHoldsTheInterpolatedValuesA
       }
     }
   EXPECT_EQ(nan_pixels, 1) << "the column with the NaN point, whose layer 2 weighs at 87.5 m";
+
+  // And equal to `terravol query` at pixel centres (the centre of pixel (row, col) is its
+  // lattice column: the tiepoint plus half a pixel).
+  const std::string dem = write_dem(std::filesystem::path(path("."))).string();
+  for (const auto& [row, col] : std::vector<std::pair<int, int>>{{0, 0}, {3, 7}, {10, 15}, {19, 29}, {12, 4}}) {
+    const double lat = c.tiepoint[4] - (row + 0.5) * c.scale[1], lon = c.tiepoint[3] + (col + 0.5) * c.scale[0];
+    char at[96];
+    std::snprintf(at, sizeof at, "%.12f,%.12f,87.5", lat, lon);
+    const auto q = run_terravol("query --volume " + vdb + " --dem " + dem + " --at " + at);
+    ASSERT_EQ(q.status, 0) << q.err;
+    const std::string line = q.out.substr(q.out.find('\n') + 1);
+    const double queried = std::stod(line.substr(line.rfind(',') + 1));
+    const float got = c.values[static_cast<std::size_t>(row) * 30 + col];
+    if (std::isnan(got)) {
+      EXPECT_TRUE(std::isnan(queried)) << row << "," << col;
+    } else {
+      EXPECT_NEAR(got, queried, 1e-4) << row << "," << col << ": " << q.out;
+    }
+  }
 }
 
 TEST_F(ExportMapCli, HeightsAboveGroundOfADatumVolumeTakeTheGroundFromTheDem) {
