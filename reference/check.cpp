@@ -252,8 +252,9 @@ RenderRun run_render(const fs::path& exe, const fs::path& scene, const fs::path&
   run.vtp = dir / (name + ".vtp");
   run.stats = dir / (name + ".json");
   run.log = dir / (name + ".log");
+  // --no-markers: the reference draws the volumes' surfaces, not the transmitter masts.
   std::vector<std::string> args{exe.string(), "render", "--scene", scene.string(), "--full-res",
-                                "--surface-triangles", "0", "--haze", "0", "--export-vtp", run.vtp.string(),
+                                "--surface-triangles", "0", "--haze", "0", "--no-markers", "--export-vtp", run.vtp.string(),
                                 "--stats", run.stats.string(), "-o", run.png.string(), "--force"};
   args.insert(args.end(), extra.begin(), extra.end());
   std::vector<char*> argv;

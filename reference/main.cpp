@@ -1,6 +1,6 @@
 // terravol_reference: the independent reference image of one render (reference/check.h), for a
 // person checking a view by hand. Run the real command first, then this one:
-//   terravol render --scene S.json --full-res --surface-triangles 0 --haze 0
+//   terravol render --scene S.json --full-res --surface-triangles 0 --haze 0 --no-markers
 //       --export-vtp drawn.vtp --stats stats.json -o ours.png [--camera ...] [--background R,G,B]
 //   terravol_reference --scene S.json --drawn drawn.vtp --stats stats.json -o reference.png
 //       --against ours.png --diff difference.png

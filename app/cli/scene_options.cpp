@@ -23,6 +23,7 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
                  "repeatable");
   cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
+  cmd.add_flag("--no-markers", args.no_markers, "No marker at the transmitters the volumes record");
 
   StyleArgs& s = args.style;
   const scene::Style defaults;
@@ -90,6 +91,7 @@ scene::SceneStyle given_style(const SceneArgs& args) {
   if (given(s.occlusion_option)) g.occlusion = s.occlusion;
   if (given(s.coherence_option)) g.coherence = s.coherence;
   if (args.no_legend) g.legend = false;
+  if (args.no_markers) g.markers = false;
   return g;
 }
 

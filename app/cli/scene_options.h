@@ -36,7 +36,7 @@ struct SceneArgs {
   std::vector<std::filesystem::path> volumes;
   std::vector<std::string> isos, slices;
   std::string volume_frame, field;
-  bool no_legend = false;
+  bool no_legend = false, no_markers = false;
   StyleArgs style;
 };
 void add_scene_options(CLI::App& cmd, SceneArgs& args);

@@ -47,6 +47,7 @@ SceneOptions scene_options(const scene::Style& style, int levels, Sliding slidin
   o.levels = levels;
   o.shading = style.shading;
   o.legend = style.legend;
+  o.markers = style.markers;
   o.surface_triangles = style.surface_triangles;
   o.sliding = sliding;
   return o;
@@ -79,7 +80,7 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
   scene_ = std::make_unique<scene::TerrainScene>(mosaic_, window, levels_);
 
   // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
-  volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), options_.surface_triangles);
+  volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), options_.surface_triangles, options_.markers);
   volumes_.merge_into(*scene_);
   lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
                                   options_.shading);

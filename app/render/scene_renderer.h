@@ -50,6 +50,7 @@ struct SceneOptions {
   int levels = 0;         // 0: scene::default_levels(window)
   scene::ShadingOptions shading;
   bool legend = true;     // a colour legend for the volumes
+  bool markers = true;    // a marker at each transmitter the volumes record (VolumeLayer)
   std::size_t surface_triangles = scene::kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
   Sliding sliding = Sliding::kSynchronous;
 };

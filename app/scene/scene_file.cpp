@@ -125,7 +125,7 @@ SceneCamera camera_of(const Reader& r, const json& j) {
 
 SceneStyle style_of(const Reader& r, const json& j) {
   r.only_keys(j, "render", {"size", "threshold", "lod_metric", "order", "tint", "window", "haze_km", "sun_azimuth",
-                            "sun_elevation", "legend", "surface_triangles", "occlusion", "coherence"});
+                            "sun_elevation", "legend", "markers", "surface_triangles", "occlusion", "coherence"});
   SceneStyle s;
   auto text = [&](const char* key, auto check) -> std::optional<std::string> {
     if (!j.contains(key)) return std::nullopt;
@@ -163,6 +163,7 @@ SceneStyle style_of(const Reader& r, const json& j) {
   if (j.contains("sun_azimuth")) s.sun_azimuth = r.number(j["sun_azimuth"], "render.sun_azimuth", -360.0, 360.0);
   if (j.contains("sun_elevation")) s.sun_elevation = r.number(j["sun_elevation"], "render.sun_elevation", 1e-3, 90.0);
   if (j.contains("legend")) s.legend = r.boolean(j["legend"], "render.legend");
+  if (j.contains("markers")) s.markers = r.boolean(j["markers"], "render.markers");
   if (j.contains("surface_triangles")) {
     s.surface_triangles = static_cast<std::size_t>(r.number(j["surface_triangles"], "render.surface_triangles", 0, 1e8));
   }

@@ -30,7 +30,7 @@ std::string quote(std::string_view option, std::string_view text) {
 constexpr auto kStyleKeys =
     std::make_tuple(&SceneStyle::width, &SceneStyle::height, &SceneStyle::threshold, &SceneStyle::lod_metric,
                     &SceneStyle::order, &SceneStyle::tint, &SceneStyle::window, &SceneStyle::haze_km,
-                    &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend,
+                    &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend, &SceneStyle::markers,
                     &SceneStyle::surface_triangles, &SceneStyle::occlusion, &SceneStyle::coherence);
 
 }  // namespace
@@ -55,6 +55,7 @@ Style resolve_style(const SceneStyle& s) {
   if (s.sun_azimuth) r.shading.sun_azimuth_deg = *s.sun_azimuth;
   if (s.sun_elevation) r.shading.sun_elevation_deg = *s.sun_elevation;
   if (s.legend) r.legend = *s.legend;
+  if (s.markers) r.markers = *s.markers;
   if (s.surface_triangles) r.surface_triangles = *s.surface_triangles;
   if (s.occlusion) r.traversal.occlusion = parse_on_off("--occlusion", *s.occlusion);
   if (s.coherence) r.traversal.coherence = parse_coherence(*s.coherence);

@@ -42,7 +42,7 @@ struct SceneStyle {
   std::optional<std::string> lod_metric, order, tint;
   std::optional<int> window;
   std::optional<double> haze_km, sun_azimuth, sun_elevation;
-  std::optional<bool> legend;
+  std::optional<bool> legend, markers;
   std::optional<std::size_t> surface_triangles;
   std::optional<std::string> occlusion, coherence;
 };
@@ -56,6 +56,7 @@ struct Style {
   int window = 1024;                // largest window side, cells, a power of two
   double haze_km = 60.0;            // 0: none
   bool legend = true;               // a colour legend when volumes are drawn
+  bool markers = true;              // a marker at each transmitter a volume records
   std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface; 0: all
   // traversal.occlusion and traversal.coherence come from "occlusion" (on | off, default off)
   // and "coherence" (off | update | conservative, default off).

@@ -34,6 +34,60 @@ std::array<float, 2> finite_range(const volume::Volume& v) {
   return {lo, hi};
 }
 
+// The transmitters a volume records: a plan's "transmitters" attribute, else a single one's
+// tx_lat, tx_lon and tx_height_agl_m (terravol rf); none when it has neither or they do not parse.
+std::vector<volume::RecordedTransmitter> transmitters_of(const volume::Volume& v) {
+  try {
+    std::vector<volume::RecordedTransmitter> tx = volume::recorded_transmitters(v);
+    if (!tx.empty()) return tx;
+    const auto lat = v.attributes.find("tx_lat"), lon = v.attributes.find("tx_lon"), h = v.attributes.find("tx_height_agl_m");
+    if (lat == v.attributes.end() || lon == v.attributes.end() || h == v.attributes.end()) return {};
+    return {{"", std::stod(lat->second), std::stod(lon->second), std::stod(h->second)}};
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+// A mast per transmitter (scene frame): a square prism of half-width 20 m from 2 m below the
+// ground to the antenna, and on it an octahedron of radius 100 m whose lowest vertex is the
+// antenna, opaque red, so that it shows as some ten pixels from 10 km. Built by hand: eight vertices and twelve triangles each
+// need no library.
+volume::Mesh marker_mesh(const std::vector<volume::RecordedTransmitter>& tx, const io::SceneFrame& frame,
+                         const GroundGrid& ground) {
+  volume::Mesh m;
+  const glm::u8vec4 red(220, 30, 40, 255);
+  const auto add = [&](const glm::dvec3& p) {
+    m.vertices.push_back(p);
+    m.colors.push_back(red);
+    return static_cast<std::uint32_t>(m.vertices.size() - 1);
+  };
+  for (const auto& t : tx) {
+    const double g = ground(t.lat, t.lon), top = g + std::max(t.height_agl, 1.0);
+    const io::ScenePoint base = frame.to_scene({t.lat, t.lon, g - 2.0}), head = frame.to_scene({t.lat, t.lon, top});
+    const glm::dvec3 b(base.x, base.y, base.z), h(head.x, head.y, head.z);
+    constexpr double w = 20.0, r = 100.0;
+    std::uint32_t lo[4], hi[4];
+    for (int c = 0; c < 4; ++c) {
+      const glm::dvec3 d((c == 0 || c == 3) ? -w : w, c < 2 ? -w : w, 0.0);
+      lo[c] = add(b + d);
+      hi[c] = add(glm::dvec3(b.x, b.y, h.z) + d);
+    }
+    for (int c = 0; c < 4; ++c) {
+      const int n = (c + 1) % 4;
+      for (const std::uint32_t i : {lo[c], lo[n], hi[n], lo[c], hi[n], hi[c]}) m.triangles.push_back(i);
+    }
+    const glm::dvec3 centre = h + glm::dvec3(0, 0, r);
+    const std::uint32_t up = add(centre + glm::dvec3(0, 0, r)), down = add(h);
+    std::uint32_t ring[4];
+    for (int c = 0; c < 4; ++c) ring[c] = add(centre + glm::dvec3(c == 0 ? r : c == 2 ? -r : 0.0, c == 1 ? r : c == 3 ? -r : 0.0, 0.0));
+    for (int c = 0; c < 4; ++c) {
+      const int n = (c + 1) % 4;
+      for (const std::uint32_t i : {ring[c], ring[n], up, ring[n], ring[c], down}) m.triangles.push_back(i);
+    }
+  }
+  return m;
+}
+
 }  // namespace
 
 // A volume as read, the ground under it, its mapper into the scene frame, and the geometry
@@ -44,8 +98,9 @@ struct VolumeLayer::Loaded {
   GroundGrid ground;
   std::unique_ptr<volume::LatticeMapper> mapper;
   std::vector<volume::Mesh> isosurfaces, slices;
-  // Changed since the last merge_into(), each surface (isosurfaces then slices); a change of
-  // the volume's visibility changes all of them.
+  volume::Mesh markers;  // its transmitters' masts (empty without markers)
+  // Changed since the last merge_into(), each surface (isosurfaces, slices, then the markers);
+  // a change of the volume's visibility changes all of them.
   std::vector<bool> changed;
   std::array<float, 2> range{0, 1};
 
@@ -72,7 +127,7 @@ VolumeLayer::VolumeLayer(VolumeLayer&&) noexcept = default;
 VolumeLayer& VolumeLayer::operator=(VolumeLayer&&) noexcept = default;
 
 VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
-                         std::size_t max_triangles)
+                         std::size_t max_triangles, bool markers)
     : max_triangles_(max_triangles) {
   const auto t0 = Clock::now();
   for (const VolumeSpec& spec : specs) {
@@ -105,7 +160,8 @@ VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic&
     v->range = finite_range(v->data);
     for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
     for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
-    v->changed.assign(v->isosurfaces.size() + v->slices.size(), true);
+    if (markers) v->markers = marker_mesh(transmitters_of(v->data), frame, v->ground);
+    v->changed.assign(v->isosurfaces.size() + v->slices.size() + 1, true);
     volumes_.push_back(std::move(v));
   }
   figures_.geometry_ms = ms_since(t0);
@@ -133,15 +189,16 @@ void VolumeLayer::merge_into(TerrainScene& scene) {
   figures_.input_triangles = 0;
   for (std::size_t v = 0; v < volumes_.size(); ++v) {
     Loaded& l = *volumes_[v];
-    const std::size_t isos = l.isosurfaces.size();
+    const std::size_t isos = l.isosurfaces.size(), surfaces = isos + l.slices.size();
     for (std::size_t k = 0; k < l.changed.size(); ++k) {
-      const volume::Mesh& m = k < isos ? l.isosurfaces[k] : l.slices[k - isos];
-      if (l.spec.visible) figures_.input_triangles += m.triangle_count();
+      const volume::Mesh& m = k < isos ? l.isosurfaces[k] : k < surfaces ? l.slices[k - isos] : l.markers;
+      if (l.spec.visible && k < surfaces) figures_.input_triangles += m.triangle_count();
       if (!fresh && !l.changed[k]) continue;
       l.changed[k] = false;
-      if (fresh && !l.spec.visible) continue;
-      const std::uint32_t kind = k < isos ? 0 : 1;
-      ids.push_back(static_cast<std::uint32_t>(v << 16 | kind << 15 | (k < isos ? k : k - isos)));
+      if (fresh && (!l.spec.visible || m.empty())) continue;
+      const std::uint32_t kind = k < isos ? 0 : k < surfaces ? 1 : 2;
+      const std::size_t index = k < isos ? k : k < surfaces ? k - isos : 0;
+      ids.push_back(static_cast<std::uint32_t>(v << 16 | kind << 14 | index));
       inputs.push_back(l.spec.visible ? mrbsp::SurfaceInput{m.vertices, m.colors, m.triangles} : mrbsp::SurfaceInput{});
     }
   }

@@ -68,8 +68,11 @@ class VolumeLayer {
   // Each isosurface is reduced to at most `max_triangles` (volume::reduced_isosurface with the
   // default edge collapse; 0: never), so that an isovalue change fits an interaction. Slices
   // are kept at the volume's resolution (volume::slice), never decimated.
+  // With `markers`, each transmitter the volume records (its "transmitters" attribute, or
+  // tx_lat/tx_lon/tx_height_agl_m of a single one) gets an opaque red mast from the ground to
+  // the antenna with a diamond at its top, merged like the surfaces (hidden with its volume).
   VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
-              std::size_t max_triangles = kDefaultSurfaceTriangles);
+              std::size_t max_triangles = kDefaultSurfaceTriangles, bool markers = true);
   ~VolumeLayer();
   VolumeLayer(VolumeLayer&&) noexcept;
   VolumeLayer& operator=(VolumeLayer&&) noexcept;
@@ -82,8 +85,8 @@ class VolumeLayer {
   volume::Mesh visible_mesh() const;
   // Brings the scene's tree up to the volumes: into a tree it has not merged into before,
   // every visible surface; else only the surfaces changed (set_*) since the last call (a
-  // hidden volume's surfaces are removed). Ids: volume << 16 | 0 (isosurface) or 1 (slice)
-  // << 15 | index.
+  // hidden volume's surfaces are removed). Ids: volume << 16 | kind << 14 | index, kind 0 for
+  // isosurfaces, 1 for slices, 2 for the volume's transmitter markers.
   void merge_into(TerrainScene& scene);
   const MergeFigures& figures() const { return figures_; }
 

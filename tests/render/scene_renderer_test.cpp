@@ -191,7 +191,7 @@ TEST(SceneRenderer, EditedVolumesDrawWhatAPipelineBuiltFromTheEditedSceneDraws) 
   }
   // Hiding the volume removes its surfaces alone; showing it again brings them back.
   edited.volumes().set_visible(0, false);
-  EXPECT_EQ(edited.remerge().merged_surfaces, 3u);
+  EXPECT_EQ(edited.remerge().merged_surfaces, 4u) << "two isosurfaces, the slice and the transmitter marker";
   EXPECT_EQ(edited.terrain().tree().merge_stats().stored_polygons, 0u);
   edited.volumes().set_visible(0, true);
   edited.remerge();
