@@ -765,9 +765,9 @@ TEST(ViewCli, TheOverlaysPartsNeverOverlapAtEitherSizeOrAfterAResize) {
   }
 }
 
-// Isosurfaces and slices are decimated to --surface-triangles each (12000 by default: this
-// volume's isosurface and slice give 23999 triangles), or to the scene file's
-// "surface_triangles"; the option wins over the file.
+// Isosurfaces are reduced to --surface-triangles each (12000 by default), or to the scene
+// file's "surface_triangles"; the option wins over the file. Slices keep the volume's
+// resolution whatever the budget.
 TEST(ViewCli, SurfaceTrianglesBudgetsEachIsosurfaceFromTheOptionOrTheSceneFileAndNeverASlice) {
   TERRAVOL_REQUIRE_XDOTOOL();
   test::TempDir dir;

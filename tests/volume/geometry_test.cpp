@@ -616,14 +616,7 @@ TEST(ParseIsosurface, ErrorsAreOneLineAndNameTheBadPart) {
 
 // Bilinear ground height over a geographic grid (row 0 north).
 GroundFunction bilinear_ground(const io::Grid& g) {
-  return [&g](double lat, double lon) {
-    const double c = (lon - g.georef.x0) / g.georef.dx, r = (g.georef.y0 - lat) / g.georef.dy;
-    const int c0 = std::clamp(static_cast<int>(std::floor(c)), 0, g.cols - 2);
-    const int r0 = std::clamp(static_cast<int>(std::floor(r)), 0, g.rows - 2);
-    const double fc = c - c0, fr = r - r0;
-    auto h = [&](int rr, int cc) { return static_cast<double>(g.heights[g.index(rr, cc)]); };
-    return (1 - fr) * ((1 - fc) * h(r0, c0) + fc * h(r0, c0 + 1)) + fr * ((1 - fc) * h(r0 + 1, c0) + fc * h(r0 + 1, c0 + 1));
-  };
+  return [&g](double lat, double lon) { return volume::dem_height(g, lat, lon); };
 }
 
 TEST(Geometry, PropagationVolumeOverTheBundledDem) {
