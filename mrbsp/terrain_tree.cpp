@@ -79,9 +79,21 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   ys.assign(w.ys.begin(), w.ys.end());
   const auto zw = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
-  positions.resize(side * side);
+  positions.resize(merged_base());
+  float lowest = std::numeric_limits<float>::max();
   for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), zw(i, j));
+    for (int i = 0; i <= n; ++i) {
+      positions[vertex(i, j)] = glm::vec3(static_cast<float>(xs[i]), static_cast<float>(ys[j]), zw(i, j));
+      lowest = std::min(lowest, zw(i, j));
+    }
+  wall_base = lowest - 100.0f;
+  for (int wall = 0; wall < 4; ++wall) {
+    for (int k = 0; k <= n; ++k) {
+      const int i = wall == 0 ? 0 : wall == 1 ? n : k, j = wall == 2 ? 0 : wall == 3 ? n : k;
+      positions[wall_vertex(wall, k)] = positions[vertex(i, j)];
+      positions[wall_bottom(wall, k)] = glm::vec3(positions[vertex(i, j)].x, positions[vertex(i, j)].y, wall_base);
+    }
+  }
 
   // LOD cells above the finest: z range and error from their samples, independent of each
   // other (TBB over the cells of each level).
@@ -342,18 +354,24 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const std::int32_t c = m.content_index.find(m.cell_id(level, ci, cj));
     return c < 0 ? nullptr : &m.content[static_cast<std::size_t>(c)];
   };
-  // The cell's terrain box, and whether the box holding its content too is in view.
+  // The window's sides the eye lies beyond (west, east, south, north): their walls are drawn.
+  const bool beyond[4] = {e.x < m.xs.front(), e.x > m.xs.back(), e.y < m.ys.front(), e.y > m.ys.back()};
+  // The cell's terrain box, and whether the box holding its content too (merged pieces up to
+  // top, walls down to bottom) is in view.
   struct Box {
     glm::vec3 lo, hi;
-    float top;
+    float top, bottom;
+    glm::vec3 content_lo() const { return glm::vec3(lo.x, lo.y, bottom); }
+    glm::vec3 content_hi() const { return glm::vec3(hi.x, hi.y, top); }
   };
   const auto box_of = [&](int level, int ci, int cj, const CellZ& cz) {
     const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
+    const bool wall = (beyond[0] && i0 == 0) || (beyond[1] && i0 + s == m.n) || (beyond[2] && j0 == 0) || (beyond[3] && j0 + s == m.n);
     return Box{glm::vec3(static_cast<float>(m.xs[static_cast<std::size_t>(i0)]), static_cast<float>(m.ys[static_cast<std::size_t>(j0)]), cz.zmin),
                glm::vec3(static_cast<float>(m.xs[static_cast<std::size_t>(i0 + s)]), static_cast<float>(m.ys[static_cast<std::size_t>(j0 + s)]), cz.zmax),
-               std::max(cz.zmax, content_top(level, ci, cj))};
+               std::max(cz.zmax, content_top(level, ci, cj)), wall ? m.wall_base : cz.zmin};
   };
-  const auto in_view = [&](const Box& b) { return !options.cull || !box_outside(planes, b.lo, glm::vec3(b.hi.x, b.hi.y, b.top)); };
+  const auto in_view = [&](const Box& b) { return !options.cull || !box_outside(planes, b.content_lo(), b.content_hi()); };
 
   // Pass 1, the LOD choice (sections 5 and 5.1): every cell in view, refined while the metric
   // asks; the drawn cells listed by level.
@@ -371,7 +389,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     ++frame.nodes_visited;
     const CellZ cz = m.cell_z(level, ci, cj);
     const Box box = box_of(level, ci, cj, cz);
-    const int planes_left = options.cull ? box_planes(planes, box.lo, glm::vec3(box.hi.x, box.hi.y, box.top), static_cast<int>(item >> 52) & 31) : 0;
+    const int planes_left = options.cull ? box_planes(planes, box.content_lo(), box.content_hi(), static_cast<int>(item >> 52) & 31) : 0;
     if (planes_left < 0) continue;
     bool refine = level < m.levels - 1;
     if (level >= 0 && refine && !options.full_res) {
@@ -460,12 +478,11 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     // side of what is inside it.
     std::uint64_t order[5];
     int count = 0;
-    const bool eye_beyond[4] = {e.x < m.xs.front(), e.x > m.xs.back(), e.y < m.ys.front(), e.y > m.ys.back()};
     order[count++] = pack(kSquare, 0, 0, 0);
     for (int side = 3; side >= 0; --side) {
       if (m.outside[side] < 0) continue;
       const std::uint64_t slot = pack_slot(m.outside[side]);
-      if (eye_beyond[side] == b2f) {
+      if (beyond[side] == b2f) {
         order[count++] = slot;  // after everything inside
       } else {
         std::move_backward(order, order + count, order + count + 1);
@@ -639,11 +656,11 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           } else {
             const Box s0 = box_of(level + 1, 2 * ci + half, 2 * cj, m.cell_z(level + 1, 2 * ci + half, 2 * cj));
             const Box s1 = box_of(level + 1, 2 * ci + half, 2 * cj + 1, m.cell_z(level + 1, 2 * ci + half, 2 * cj + 1));
-            b = {glm::min(s0.lo, s1.lo), glm::max(s0.hi, s1.hi), std::max(s0.top, s1.top)};
+            b = {glm::min(s0.lo, s1.lo), glm::max(s0.hi, s1.hi), std::max(s0.top, s1.top), std::min(s0.bottom, s1.bottom)};
           }
           double near_depth = std::numeric_limits<double>::max(), extent = 0.0;
           for (int k = 0; k < 8; ++k) {
-            const glm::dvec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.top : b.lo.z);
+            const glm::dvec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.top : b.bottom);
             double depth = 0.0;
             if (!project(p, corners[k], depth)) return true;  // reaches the eye's plane: visible
             near_depth = std::min(near_depth, depth);
@@ -742,6 +759,23 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       if (first >= 0) st.push_back(first);
     }
   };
+  // A drawn cell's walls: on each window side the eye lies beyond and the cell touches, the
+  // quad from the cell's edge (copies of its two boundary samples) down to wall_base, in the
+  // boundary plane and the cell's box. Like a crack fill facing the eye, after the cell's
+  // triangles.
+  const auto emit_walls = [&](int level, int ci, int cj) {
+    const int s = m.cell_size(level);
+    for (int side = 0; side < 4; ++side) {
+      if (!beyond[side]) continue;
+      const int i0 = ci * s, j0 = cj * s;
+      const bool touches = side == 0 ? i0 == 0 : side == 1 ? i0 + s == m.n : side == 2 ? j0 == 0 : j0 + s == m.n;
+      if (!touches) continue;
+      const int k0 = side < 2 ? j0 : i0, k1 = k0 + s;  // the edge's samples along the side
+      const std::uint32_t a = m.wall_vertex(side, k0), b = m.wall_vertex(side, k1);
+      emit(a, b, m.wall_bottom(side, k1), kWallLevel);
+      emit(a, m.wall_bottom(side, k1), m.wall_bottom(side, k0), kWallLevel);
+    }
+  };
   for (const std::uint64_t item : leaves) {
     if (kind_of(item) == kEmitSlot) {
       emit_store(m.slots[static_cast<std::size_t>(slot_of(item))].store);
@@ -764,6 +798,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           ++frame.crack_triangles;
         }
       }
+      if (!away) emit_walls(level, ci, cj);  // they face the eye
     };
     emit_fills(back_to_front);
 

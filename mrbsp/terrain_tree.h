@@ -79,6 +79,7 @@ struct TraversalOptions {
 // Frame::level values other than terrain levels (0 coarsest, levels-1 finest).
 inline constexpr std::int8_t kCrackLevel = -1;   // a crack fill
 inline constexpr std::int8_t kMergedLevel = -2;  // a merged polygon (isosurface, slice, ...)
+inline constexpr std::int8_t kWallLevel = -3;    // a wall closing a window side the eye is beyond
 
 // What merging did (section 4.2), for the whole tree after the last change.
 struct MergeStats {

@@ -148,7 +148,9 @@ struct TerrainTree::Impl {
   int levels = 0;  // L
   int top = 0;     // m: top levels -1 .. -m
   std::vector<double> xs, ys;
-  std::vector<glm::vec3> positions;  // lattice, row bottoms, column bottoms, merged vertices
+  // The lattice, the walls' vertices (wall_vertex()), then the merged vertices.
+  std::vector<glm::vec3> positions;
+  float wall_base = 0.0f;  // the walls' bottom: 100 m below the window's lowest sample
   // Per level index l + top (l = -m .. L-2): its cells' figures, row-major from the south-west.
   std::vector<CellZ> cellz;               // every level above the finest, coarsest first
   std::vector<std::size_t> cellz_offset;  // per level index l + top: where its cells start
@@ -177,7 +179,13 @@ struct TerrainTree::Impl {
   }
   std::uint32_t vertex(int i, int j) const { return static_cast<std::uint32_t>(j * (n + 1) + i); }
   std::uint32_t lattice_count() const { return static_cast<std::uint32_t>((n + 1) * (n + 1)); }
-  std::uint32_t merged_base() const { return lattice_count(); }
+  // Walls close the window's sides toward an eye beyond them (traverse()): in the boundary
+  // plane of side s (0 west, 1 east, 2 south, 3 north), a copy of each boundary sample k
+  // (k = j on the west and east sides, i on the south and north, 0 .. n), then the same
+  // samples lowered to wall_base.
+  std::uint32_t wall_vertex(int side, int k) const { return lattice_count() + static_cast<std::uint32_t>(2 * side * (n + 1) + k); }
+  std::uint32_t wall_bottom(int side, int k) const { return wall_vertex(side, n + 1 + k); }
+  std::uint32_t merged_base() const { return lattice_count() + static_cast<std::uint32_t>(8 * (n + 1)); }
   float z(int i, int j) const { return positions[vertex(i, j)].z; }
   // The figures of a cell at any level >= -top; the finest level's from its four samples.
   CellZ cell_z(int level, int ci, int cj) const;

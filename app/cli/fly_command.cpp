@@ -71,7 +71,6 @@ std::uint64_t file_hash(const std::filesystem::path& p) {
   return h;
 }
 
-bool inside(const io::Mosaic& m, double lat, double lon) { return scene::inside(m, scene::lattice_point(m, lat, lon)); }
 
 // The keys around time t, for messages: "keys[2] and keys[3]" or "keys[2]".
 std::string keys_around(const std::vector<scene::PathKey>& keys, double t) {
@@ -210,8 +209,10 @@ void run_fly(const FlyOptions& o) {
   const scene::PathKey& k0 = file.keys.front();
   scene.camera = scene::SceneCamera{scene::CameraPose{k0.lat, k0.lon, k0.alt, 0.0, 0.0}, k0.agl, default_fov};
   io::Mosaic mosaic = io::Mosaic::open(scene.dems);
-  if (!inside(mosaic, k0.lat, k0.lon)) {
-    throw std::invalid_argument(source + ": keys[0]: " + fixed(k0.lat, 5) + ", " + fixed(k0.lon, 5) + " is outside the DEM");
+  if (scene::km_beyond(mosaic, k0.lat, k0.lon) > scene::kMaxKmBeyond) {
+    throw std::invalid_argument(source + ": keys[0]: " + fixed(k0.lat, 5) + ", " + fixed(k0.lon, 5) + " is " +
+                                fixed(scene::km_beyond(mosaic, k0.lat, k0.lon), 1) + " km beyond the DEM (at most " +
+                                fixed(scene::kMaxKmBeyond, 0) + " km)");
   }
   render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
@@ -229,9 +230,10 @@ void run_fly(const FlyOptions& o) {
     const scene::PathSample s = path.at(t);
     const std::string when = source + ": at t=" + fixed(t, 2) + " s (frame " + std::to_string(k) + ", " +
                              keys_around(file.keys, t) + ")";
-    if (!inside(renderer.mosaic(), s.pose.lat, s.pose.lon)) {
-      throw std::invalid_argument(when + " the camera (" + fixed(s.pose.lat, 5) + ", " + fixed(s.pose.lon, 5) +
-                                  ") is outside the DEM");
+    if (scene::km_beyond(renderer.mosaic(), s.pose.lat, s.pose.lon) > scene::kMaxKmBeyond) {
+      throw std::invalid_argument(when + " the camera (" + fixed(s.pose.lat, 5) + ", " + fixed(s.pose.lon, 5) + ") is " +
+                                  fixed(scene::km_beyond(renderer.mosaic(), s.pose.lat, s.pose.lon), 1) +
+                                  " km beyond the DEM (at most " + fixed(scene::kMaxKmBeyond, 0) + " km)");
     }
     const double ground = renderer.ground_height(s.pose.lat, s.pose.lon);
     const double clearance = path.agl() ? s.pose.alt : s.pose.alt - ground;

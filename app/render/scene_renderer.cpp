@@ -71,7 +71,7 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
                              const SceneOptions& options)
     : mosaic_(std::move(mosaic)), settings_(settings), options_(options) {
   const scene::CameraPose at = scene.camera ? scene.camera->pose : scene::default_pose(mosaic_);
-  scene::require_inside(mosaic_, at.lat, at.lon);
+  scene::require_near(mosaic_, at.lat, at.lon);
   require_x_display();
   const scene::LatticePoint p = scene::lattice_point(mosaic_, at.lat, at.lon);
   const scene::WindowChoice window =
@@ -243,13 +243,18 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
 
 FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, double fov_y_deg,
                                   const mrbsp::TraversalOptions& traversal) {
-  scene::require_inside(mosaic_, pose.lat, pose.lon);
+  scene::require_near(mosaic_, pose.lat, pose.lon);
   FrameStats stats;
   slide(pose, stats);
 
   stats.ground_height = ground_height(pose.lat, pose.lon);
   stats.eye_height = eye_above(stats.ground_height, pose, agl);
-  const double clearance = stats.eye_height - stats.ground_height;
+  // The near plane from the eye's distance to the terrain: its height above the ground, or
+  // from a camera beyond the window its distance to the window's box, if that is more.
+  const double ex = scene_->frame().x_of_lon(pose.lon), ey = scene_->frame().y_of_lat(pose.lat);
+  const double beyond_x = std::max({scene_->xs().front() - ex, ex - scene_->xs().back(), 0.0});
+  const double beyond_y = std::max({scene_->ys().front() - ey, ey - scene_->ys().back(), 0.0});
+  const double clearance = std::max(stats.eye_height - stats.ground_height, std::hypot(beyond_x, beyond_y));
   const int* size = renderer_->window()->GetSize();
   camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, std::max(size[0], 1),
                                      std::max(size[1], 1), scene::near_plane_for(clearance));
@@ -276,7 +281,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
 double SceneRenderer::draw() { return renderer_->render(); }
 
 bool SceneRenderer::slide_for(const scene::CameraPose& pose) {
-  scene::require_inside(mosaic_, pose.lat, pose.lon);
+  scene::require_near(mosaic_, pose.lat, pose.lon);
   const int before = slides_;
   FrameStats stats;
   slide(pose, stats);
@@ -326,6 +331,7 @@ std::optional<Pick> SceneRenderer::pick(int x, int y) const {
 }
 
 double SceneRenderer::ground_height(double lat, double lon) const {
+  scene::clamp_to_mosaic(mosaic_, lat, lon);  // beyond the DEM: the ground at its nearest point
   const scene::WindowBounds b = scene_->bounds();
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
   const io::Georef& g = mosaic_.georef();

@@ -98,8 +98,11 @@ class SceneRenderer {
   // Everything of a frame but the draw: slides the window first (see Sliding) when auto-slide is
   // on and the camera is within a quarter of the window's side of an edge, sets the camera (the
   // window's current size in pixels) and the sky, traverses the tree and replaces the triangle
-  // list. Throws std::runtime_error when the camera is outside the mosaic or not above the
-  // ground, and, with kSynchronous, io::FormatError when the moved window cannot be read.
+  // list. A camera beyond the mosaic is allowed (up to scene::kMaxKmBeyond): the window is then
+  // the part of the mosaic nearest it, with walls closing the sides it sees
+  // (mrbsp::TerrainTree::traverse()). Throws std::runtime_error when the camera is farther, or
+  // not above the ground, and, with kSynchronous, io::FormatError when the moved window cannot
+  // be read.
   FrameStats prepare(const scene::CameraPose& pose, bool agl, double fov_y_deg,
                      const mrbsp::TraversalOptions& traversal);
   // Draws the prepared frame and waits for it; returns wall milliseconds.
@@ -135,7 +138,8 @@ class SceneRenderer {
   // values there. Nothing when the pixel shows sky or lies beyond the window.
   std::optional<Pick> pick(int x, int y) const;
 
-  // Bilinear ground height (metres, DEM datum) anywhere in the mosaic, voids filled.
+  // Bilinear ground height (metres, DEM datum) anywhere in the mosaic, voids filled; beyond
+  // the mosaic, the height at its nearest point (the ground a camera out there is above).
   double ground_height(double lat, double lon) const;
   const io::Mosaic& mosaic() const { return mosaic_; }
   const io::SceneFrame& frame() const { return scene_->frame(); }

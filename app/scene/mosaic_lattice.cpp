@@ -26,13 +26,25 @@ bool inside(const io::Mosaic& mosaic, const LatticePoint& p) {
          p.col <= mosaic.cols() - 1 + kEdgeTolerance;
 }
 
-void require_inside(const io::Mosaic& mosaic, double lat, double lon) {
-  if (inside(mosaic, lattice_point(mosaic, lat, lon))) return;
+double km_beyond(const io::Mosaic& mosaic, double lat, double lon) {
+  double clat = lat, clon = lon;
+  clamp_to_mosaic(mosaic, clat, clon);
+  constexpr double kKmPerDegree = 111.2;
+  const double north = (lat - clat) * kKmPerDegree;
+  const double east = std::remainder(lon - clon, 360.0) * kKmPerDegree * std::cos(lat * 3.14159265358979323846 / 180.0);
+  return std::hypot(north, east);
+}
+
+void require_near(const io::Mosaic& mosaic, double lat, double lon) {
+  const double km = km_beyond(mosaic, lat, lon);
+  if (km <= kMaxKmBeyond) return;
   const io::Georef& g = mosaic.georef();
   const double south = g.y0 - (mosaic.rows() - 1) * g.dy, east = g.x0 + (mosaic.cols() - 1) * g.dx;
-  throw std::runtime_error("camera " + degrees(lat, 'N', 'S') + ", " + degrees(lon, 'E', 'W') +
-                           " is outside the DEM (" + degrees(south, 'N', 'S') + " .. " + degrees(g.y0, 'N', 'S') +
-                           ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') + ")");
+  char b[64];
+  std::snprintf(b, sizeof b, " is %.1f km beyond the DEM (", km);
+  throw std::runtime_error("camera " + degrees(lat, 'N', 'S') + ", " + degrees(lon, 'E', 'W') + b + degrees(south, 'N', 'S') +
+                           " .. " + degrees(g.y0, 'N', 'S') + ", " + degrees(g.x0, 'E', 'W') + " .. " + degrees(east, 'E', 'W') +
+                           "; at most " + std::to_string(static_cast<int>(kMaxKmBeyond)) + " km)");
 }
 
 void clamp_to_mosaic(const io::Mosaic& mosaic, double& lat, double& lon) {
@@ -40,6 +52,16 @@ void clamp_to_mosaic(const io::Mosaic& mosaic, double& lat, double& lon) {
   const double south = g.y0 - (mosaic.rows() - 1) * g.dy;
   lat = std::clamp(lat, south, g.y0);
   lon = std::remainder(g.x0 + std::clamp(east_of_west(g, lon), 0.0, (mosaic.cols() - 1) * g.dx), 360.0);
+}
+
+void clamp_near_mosaic(const io::Mosaic& mosaic, double& lat, double& lon) {
+  const double km = km_beyond(mosaic, lat, lon);
+  if (km <= kMaxKmBeyond) return;
+  double clat = lat, clon = lon;
+  clamp_to_mosaic(mosaic, clat, clon);
+  const double t = kMaxKmBeyond / km;  // back along the way to the nearest point
+  lat = clat + t * (lat - clat);
+  lon = std::remainder(clon + t * std::remainder(lon - clon, 360.0), 360.0);
 }
 
 CameraPose default_pose(const io::Mosaic& mosaic) {

@@ -1,7 +1,7 @@
 // Geographic points on a DEM mosaic's sample lattice: the one place for the arithmetic that
 // turns a longitude into a column (longitudes taken modulo 360 east of the mosaic's west edge,
-// so a mosaic may cross the antimeridian), the check that a camera lies inside the mosaic, the
-// default camera over it, and degrees as text for messages.
+// so a mosaic may cross the antimeridian), the check that a camera lies near enough to the
+// mosaic, the default camera over it, and degrees as text for messages.
 #pragma once
 
 #include <string>
@@ -24,12 +24,25 @@ LatticePoint lattice_point(const io::Mosaic& mosaic, double lat, double lon);
 // (a point clamped to the mosaic's edge in degrees is inside).
 bool inside(const io::Mosaic& mosaic, const LatticePoint& p);
 
-// Throws std::runtime_error("camera 47.50000 N, 6.50000 E is outside the DEM (45.00000 N ..
-// 46.00000 N, 6.00000 E .. 7.00000 E)") unless (lat, lon) is inside the mosaic.
-void require_inside(const io::Mosaic& mosaic, double lat, double lon);
+// How far (lat, lon) lies beyond the mosaic's edges, in kilometres (0 inside): the degrees
+// beyond its latitude and longitude ranges at 111.2 km per degree (longitude's times
+// cos(lat)), combined as a hypotenuse. Accurate to a percent or so: it bounds cameras.
+double km_beyond(const io::Mosaic& mosaic, double lat, double lon);
+
+// Cameras may lie beyond the DEM (an overview from outside a tile), up to this far: farther, a
+// tile of a degree is a few pixels across, and the position is taken for a typing mistake.
+inline constexpr double kMaxKmBeyond = 200.0;
+
+// Throws std::runtime_error("camera 47.50000 N, 6.50000 E is 250.1 km beyond the DEM (45.00000 N
+// .. 46.00000 N, 6.00000 E .. 7.00000 E; at most 200 km)") when (lat, lon) lies more than
+// kMaxKmBeyond beyond the mosaic.
+void require_near(const io::Mosaic& mosaic, double lat, double lon);
 
 // The nearest point of the mosaic to (lat, lon), in place; longitude in [-180, 180].
 void clamp_to_mosaic(const io::Mosaic& mosaic, double& lat, double& lon);
+// The nearest point to (lat, lon) at most kMaxKmBeyond beyond the mosaic, in place (the
+// viewer's flight stops there).
+void clamp_near_mosaic(const io::Mosaic& mosaic, double& lat, double& lon);
 
 // The camera `terravol view` starts from without --camera: 1500 m above the ground (alt is
 // above the ground) over the mosaic's centre sample, heading north, pitch -15 degrees.

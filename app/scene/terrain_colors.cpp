@@ -171,8 +171,13 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   out.shade.resize(total);
   out.rgba.resize(total);
   out.tcoords.resize(total, glm::vec2(-1.0f));
-  for (std::size_t v = 0; v < terrain_vertices; ++v) {
-    const std::size_t t = v % samples;
+  for (std::size_t v = samples; v < terrain_vertices; ++v) {
+    out.normals[v] = glm::vec3(0.0f, 0.0f, 1.0f);
+    out.shade[v] = 1.0f;
+    out.rgba[v] = kWallColor;
+  }
+  for (std::size_t v = 0; v < std::min(terrain_vertices, samples); ++v) {
+    const std::size_t t = v;
     out.normals[v] = lattice.normals[t];
     out.shade[v] = lattice.shade[t];
     out.rgba[v] = lattice.rgba[t];

@@ -50,11 +50,13 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
                              std::span<const float> z, std::span<const float> heights,
                              const ShadingOptions& options);
 
-// The attributes of the tree's vertices (TerrainTree::positions()): vertex v below
-// `terrain_vertices` (TerrainTree::merged_base()) is lattice sample v and copies its
-// attributes; the vertices after it are merged polygons', with `merged_colors`,
-// normal +z, shade 1 and texture coordinates (-1, -1) (the renderer draws their own colour
-// there, not the texture). Precondition: lattice from shade_terrain.
+// The attributes of the tree's vertices (TerrainTree::positions()): vertex v below the
+// lattice's sample count is lattice sample v and copies its attributes; the vertices from there
+// up to `terrain_vertices` (TerrainTree::merged_base()) are the walls' (the tree's window sides
+// seen from beyond), kWallColor; the vertices after it are merged polygons', with
+// `merged_colors`. Walls and merged polygons have normal +z, shade 1 and texture coordinates
+// (-1, -1) (the renderer draws their own colour there, not the texture). Precondition:
+// lattice from shade_terrain.
 TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
                               std::span<const glm::u8vec4> merged_colors);
 
@@ -67,6 +69,7 @@ Rgba tint_of(float height, Tint tint, float lo, float hi);
 Rgba lod_color(int level);
 // The colour of crack fills (Frame::level -1) under --lod-colors: neutral grey.
 inline constexpr Rgba kCrackColor{150, 150, 150, 255};
+inline constexpr Rgba kWallColor{112, 96, 78, 255};  // the earth of a window side seen from beyond it
 
 // The sky behind the terrain as VTK's linear background gradient (bottom to top of the image):
 // the haze colour kHorizon at the horizon line, deepening toward kZenith with elevation, so

@@ -591,7 +591,7 @@ void Viewer::tick() {
     const render::SceneRenderer& pipeline = *pipeline_;
     pose_ = scene::fly(pose_, in, dt, pipeline.frame(),
                        [&pipeline](double lat, double lon) { return pipeline.ground_height(lat, lon); }, flight_);
-    scene::clamp_to_mosaic(pipeline.mosaic(), pose_.lat, pose_.lon);
+    scene::clamp_near_mosaic(pipeline.mosaic(), pose_.lat, pose_.lon);
     dirty_ = true;
   }
   tapped_.clear();

@@ -257,7 +257,7 @@ TEST(FlyCli, BadPathFilesFailWithOneLineBeforeAnyFrame) {
   expect_rejected(dir, flight().dump(), "out.avi: not a video", "", "out.avi");
 }
 
-TEST(FlyCli, CameraUnderGroundOrOffTheDemFailsBeforeAnyFrame) {
+TEST(FlyCli, CameraUnderGroundOrFarBeyondTheDemFailsBeforeAnyFrame) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;
   json doc = flight();
@@ -265,8 +265,8 @@ TEST(FlyCli, CameraUnderGroundOrOffTheDemFailsBeforeAnyFrame) {
   doc["keys"][1]["alt"] = 200;  // far below the Alps
   expect_rejected(dir, doc.dump(), "bad.json: at t=");
   doc = flight();
-  doc["keys"][2]["lat"] = 46.5;  // north of the tile
-  expect_rejected(dir, doc.dump(), "is outside the DEM");
+  doc["keys"][2]["lat"] = 48.5;  // 278 km north of the tile
+  expect_rejected(dir, doc.dump(), "km beyond the DEM (at most 200 km)");
 }
 
 }  // namespace

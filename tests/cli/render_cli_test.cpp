@@ -200,8 +200,8 @@ TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-100", "pitch");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --size 0x0", "--size");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --size 1280", "--size");
-  expect_clean_failure(dem + " --camera 47.5,6.5,3000,0,-10", "outside the DEM");
-  expect_clean_failure(dem + " --camera 45.5,8.5,3000,0,-10", "outside the DEM");
+  expect_clean_failure(dem + " --camera 48.5,6.5,3000,0,-10", "278.0 km beyond the DEM");
+  expect_clean_failure(dem + " --camera 45.5,10.5,3000,0,-10", "km beyond the DEM");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --lod-metric pixels", "--lod-metric");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --order painter", "--order");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --window 1000", "--window");

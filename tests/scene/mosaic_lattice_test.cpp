@@ -2,6 +2,7 @@
 // 3", north-west sample at 46 N, 6 E), worked out by hand.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -32,14 +33,27 @@ TEST(MosaicLattice, InsideIsTheClosedBoxOfSamples) {
   EXPECT_FALSE(inside(m, lattice_point(m, 46.001, 6.5)));
   EXPECT_FALSE(inside(m, lattice_point(m, 45.5, 7.001)));
   EXPECT_FALSE(inside(m, lattice_point(m, 45.5, 5.999)));
-  EXPECT_NO_THROW(require_inside(m, 45.5, 6.5));
+}
+
+TEST(MosaicLattice, CamerasMayLieUpTo200KmBeyondTheDem) {
+  const io::Mosaic m = bundled();
+  EXPECT_DOUBLE_EQ(km_beyond(m, 45.5, 6.5), 0.0);
+  EXPECT_NEAR(km_beyond(m, 47.5, 6.5), 1.5 * 111.2, 1e-9);
+  EXPECT_NEAR(km_beyond(m, 45.5, 8.0), 111.2 * std::cos(45.5 * 3.14159265358979323846 / 180.0), 1e-9);
+  EXPECT_NO_THROW(require_near(m, 45.5, 6.5));
+  EXPECT_NO_THROW(require_near(m, 47.5, 6.5));
   try {
-    require_inside(m, 47.5, 6.5);
-    FAIL() << "47.5 N is north of the tile";
+    require_near(m, 48.5, 6.5);
+    FAIL() << "48.5 N is 278 km north of the tile";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()),
-              "camera 47.50000 N, 6.50000 E is outside the DEM (45.00000 N .. 46.00000 N, 6.00000 E .. 7.00000 E)");
+              "camera 48.50000 N, 6.50000 E is 278.0 km beyond the DEM (45.00000 N .. 46.00000 N, 6.00000 E .. 7.00000 E; "
+              "at most 200 km)");
   }
+  double lat = 49.0, lon = 6.5;  // 333.6 km north: back to 200 km
+  clamp_near_mosaic(m, lat, lon);
+  EXPECT_NEAR(km_beyond(m, lat, lon), 200.0, 1e-6);
+  EXPECT_DOUBLE_EQ(lon, 6.5);
 }
 
 TEST(MosaicLattice, ClampingMovesAPointToTheNearestEdge) {
