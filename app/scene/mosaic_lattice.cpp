@@ -59,7 +59,9 @@ void clamp_near_mosaic(const io::Mosaic& mosaic, double& lat, double& lon) {
   if (km <= kMaxKmBeyond) return;
   double clat = lat, clon = lon;
   clamp_to_mosaic(mosaic, clat, clon);
-  const double t = kMaxKmBeyond / km;  // back along the way to the nearest point
+  // Back along the way to the nearest point, a little inside the limit (the longitude's scale
+  // changes with the latitude, so the limit itself could round outside).
+  const double t = 0.999 * kMaxKmBeyond / km;
   lat = clat + t * (lat - clat);
   lon = std::remainder(clon + t * std::remainder(lon - clon, 360.0), 360.0);
 }

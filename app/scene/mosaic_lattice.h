@@ -40,8 +40,8 @@ void require_near(const io::Mosaic& mosaic, double lat, double lon);
 
 // The nearest point of the mosaic to (lat, lon), in place; longitude in [-180, 180].
 void clamp_to_mosaic(const io::Mosaic& mosaic, double& lat, double& lon);
-// The nearest point to (lat, lon) at most kMaxKmBeyond beyond the mosaic, in place (the
-// viewer's flight stops there).
+// (lat, lon) moved toward the mosaic's nearest point until it lies 0.999 kMaxKmBeyond beyond
+// the mosaic, in place, when it lies farther (the viewer's flight stops there).
 void clamp_near_mosaic(const io::Mosaic& mosaic, double& lat, double& lon);
 
 // The camera `terravol view` starts from without --camera: 1500 m above the ground (alt is

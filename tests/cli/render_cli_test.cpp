@@ -86,6 +86,52 @@ TEST(RenderCli, BspOrderMatchesTheDepthBufferReference) {
   EXPECT_LE(share, 0.005) << share * 100 << "% of pixels differ";
 }
 
+// A camera beyond the DEM (south of the bundled tile, low, looking north) sees the window's
+// terrain closed by the wall of its south side: in every column, the pixels between the
+// topmost and the bottommost that are not background are none of them background (the
+// window's solid projects to one interval per column; a hole would be the terrain's open
+// underside), and the wall's earth colour fills a good part of the image.
+TEST(RenderCli, CameraBeyondTheDemSeesTheTileClosedByAWall) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto png = dir.path() / "beyond.png";
+  const auto r = run_terravol("render " + bundled_dem() + " --agl --camera 44.96,6.5,800,10,-8 --size 480x270 --haze 0 " +
+                              "--background 255,0,255 -o " + png.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto img = test::read_png(png);
+  std::size_t holes = 0, solid = 0;
+  for (int x = 0; x < img.width; ++x) {
+    int top = -1, bottom = -1;
+    for (int y = 0; y < img.height; ++y) {
+      if (test::same_color(img.at(x, y), kMagenta, 0)) continue;
+      if (top < 0) top = y;
+      bottom = y;
+    }
+    for (int y = top; y >= 0 && y <= bottom; ++y) holes += test::same_color(img.at(x, y), kMagenta, 0) ? 1 : 0;
+    solid += top >= 0 ? static_cast<std::size_t>(bottom - top + 1) : 0;
+  }
+  EXPECT_EQ(holes, 0u);
+  EXPECT_GT(solid, static_cast<std::size_t>(img.width) * img.height / 4) << "the tile fills much of the view";
+  EXPECT_GT(test::color_share(img, test::Rgb8{112, 96, 78}, 40), 0.15) << "the south wall is seen";
+}
+
+// From beyond the DEM too, the tree's order (walls included) against VTK's depth-tested draw
+// of the very same triangles: only silhouette pixels may differ.
+TEST(RenderCli, BspOrderFromBeyondTheDemMatchesTheDepthBufferReference) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const std::string view = bundled_dem() + " --agl --camera 44.93,5.95,900,40,-6 --size 480x270 -o ";
+  const auto bsp = dir.path() / "bsp.png", zbuffer = dir.path() / "zbuffer.png";
+  auto r = run_terravol("render " + view + bsp.string() + " --order bsp");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_terravol("render " + view + zbuffer.string() + " --order zbuffer");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto a = test::read_png(bsp), b = test::read_png(zbuffer);
+  const double share = test::differing_share(a, b, 8);
+  EXPECT_LE(share, 0.005) << share * 100 << "% of pixels differ";
+  EXPECT_GT(test::color_share(a, test::Rgb8{112, 96, 78}, 60), 0.02) << "two walls are seen";
+}
+
 // No cracks: with each level in its own colour and a background the terrain never takes, no
 // background pixel appears below the terrain's horizon line, from low oblique views.
 struct CrackView {

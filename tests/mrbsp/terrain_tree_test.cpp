@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <random>
@@ -53,13 +54,20 @@ TEST(TerrainTree, FlatTerrainNeedsOnlyTheCoarsestLevelUnderTheErrorMetric) {
   EXPECT_EQ(f.nodes_visited, 5u);
 }
 
-TEST(TerrainTree, PositionsAreTheLatticeSamples) {
+TEST(TerrainTree, PositionsAreTheLatticeSamplesThenTheirWallCopies) {
   const TestWindow w(4, [](int i, int j) { return static_cast<float>(i * 10 + j); });
   const TerrainTree tree(w.view(), 2);
   const auto& p = tree.positions();
-  ASSERT_EQ(p.size(), 25u);
-  EXPECT_EQ(tree.merged_base(), 25u);
+  ASSERT_EQ(p.size(), 25u + 8 * 5);
+  EXPECT_EQ(tree.merged_base(), 65u);
   EXPECT_EQ(p[7], glm::vec3(200.0f, 100.0f, 21.0f));
+  // West side: the copies of samples (0, j), then the same 100 m below the lowest sample (0).
+  for (int j = 0; j <= 4; ++j) {
+    EXPECT_EQ(p[25 + static_cast<std::size_t>(j)], p[static_cast<std::size_t>(j * 5)]);
+    EXPECT_EQ(p[30 + static_cast<std::size_t>(j)], glm::vec3(p[static_cast<std::size_t>(j * 5)].x, p[static_cast<std::size_t>(j * 5)].y, -100.0f));
+  }
+  // North side (the fourth): samples (i, 4).
+  EXPECT_EQ(p[25 + 30 + 3], p[4 * 5 + 3]);
 }
 
 TEST(TerrainTree, RegionsBehindTheCameraAreCulled) {
@@ -130,18 +138,24 @@ TEST(TerrainTree, CrackFillsCanBeLeftOut) {
 // Balance and crack fills make the drawn terrain watertight: every edge of a drawn triangle
 // (crack fills included) inside the window is shared by exactly two drawn triangles, whatever
 // the thresholds and eyes, and no two drawn neighbours differ by more than one level.
-TEST(TerrainTree, DrawnTerrainIsWatertightAndNeighboursDifferByAtMostOneLevel) {
+// Edges are compared by their end points' positions, so that a wall's top edge (copies of the
+// boundary samples) meets the terrain's border edge it hangs from.
+TEST(TerrainTree, DrawnTerrainIsWatertightWithWallsOnTheSidesTheEyeIsBeyond) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> h(0.0f, 300.0f);
   std::vector<float> heights(65 * 65);
   for (float& v : heights) v = h(rng);
   const TestWindow w(64, [&](int i, int j) { return heights[static_cast<std::size_t>(j * 65 + i)]; });
   const TerrainTree tree(w.view(), 6);
+  const auto& p = tree.positions();
+  const float x0 = p[0].x, x1 = p[64].x, y0 = p[0].y, y1 = p[64 * 65].y;
+  const float base = *std::min_element(heights.begin(), heights.end()) - 100.0f;
   std::uniform_real_distribution<double> xy(-1000.0, 7400.0), z(350.0, 3000.0);
-  std::size_t fills = 0, balanced = 0;
+  std::size_t fills = 0, balanced = 0, walled_frames = 0;
   for (int trial = 0; trial < 30; ++trial) {
     Camera c;
     c.eye = {xy(rng), xy(rng), z(rng)};
+    const bool beyond[4] = {c.eye.x < x0, c.eye.x > x1, c.eye.y < y0, c.eye.y > y1};
     TraversalOptions o;
     o.cull = false;
     o.threshold_px = 0.5f * static_cast<float>(1 << (trial % 6));
@@ -151,28 +165,58 @@ TEST(TerrainTree, DrawnTerrainIsWatertightAndNeighboursDifferByAtMostOneLevel) {
     tree.traverse(c, o, f);
     fills += f.crack_triangles;
     balanced += f.balanced_cells;
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    const bool any_beyond = beyond[0] || beyond[1] || beyond[2] || beyond[3];
+    const auto walls = std::count(f.level.begin(), f.level.end(), kWallLevel);
+    EXPECT_EQ(walls > 0, any_beyond) << "trial " << trial;
+    walled_frames += walls > 0 ? 1 : 0;
+    using Key = std::array<float, 3>;
+    const auto key = [&](std::uint32_t v) { return Key{p[v].x, p[v].y, p[v].z}; };
+    std::map<std::pair<Key, Key>, int> uses;
     for (std::size_t t = 0; t < f.level.size(); ++t) {
+      if (f.level[t] == kWallLevel) {
+        for (int k = 0; k < 3; ++k) {
+          const glm::vec3 q = p[f.indices[3 * t + k]];
+          const bool in_a_walled_plane = (beyond[0] && q.x == x0) || (beyond[1] && q.x == x1) || (beyond[2] && q.y == y0) ||
+                                         (beyond[3] && q.y == y1);
+          EXPECT_TRUE(in_a_walled_plane) << "trial " << trial;
+        }
+      }
       for (int k = 0; k < 3; ++k) {
-        std::uint32_t a = f.indices[3 * t + k], b = f.indices[3 * t + (k + 1) % 3];
-        if (a > b) std::swap(a, b);
+        Key a = key(f.indices[3 * t + k]), b = key(f.indices[3 * t + (k + 1) % 3]);
+        if (b < a) std::swap(a, b);
         ++uses[{a, b}];
       }
     }
-    const auto on_border = [&](std::uint32_t v) {
-      const std::uint32_t i = v % 65, j = v / 65;
-      return i == 0 || j == 0 || i == 64 || j == 64;
+    // Expected uses: 2 inside; a border edge 1, or 2 on a walled side; a wall's bottom edge 1;
+    // a wall's vertical edge at a window corner 1, or 2 where two walled sides meet there.
+    const auto side_of = [&](const Key& a, const Key& b) {
+      if (a[0] == x0 && b[0] == x0) return 0;
+      if (a[0] == x1 && b[0] == x1) return 1;
+      if (a[1] == y0 && b[1] == y0) return 2;
+      if (a[1] == y1 && b[1] == y1) return 3;
+      return -1;
     };
     int open = 0;
     for (const auto& [edge, count] : uses) {
-      const bool border = on_border(edge.first) && on_border(edge.second) &&
-                          (edge.first % 65 == edge.second % 65 || edge.first / 65 == edge.second / 65);
-      if (count != (border ? 1 : 2)) ++open;
+      const auto& [a, b] = edge;
+      int expected = 2;
+      const bool vertical = a[0] == b[0] && a[1] == b[1];
+      const bool corner = (a[0] == x0 || a[0] == x1) && (a[1] == y0 || a[1] == y1);
+      if (a[2] == base && b[2] == base) {
+        expected = 1;
+      } else if (vertical && corner) {
+        expected = (beyond[a[0] == x0 ? 0 : 1] ? 1 : 0) + (beyond[a[1] == y0 ? 2 : 3] ? 1 : 0);
+      } else if (!vertical && side_of(a, b) >= 0 && a[2] != base && b[2] != base) {
+        expected = beyond[side_of(a, b)] ? 2 : 1;
+      }
+      if (count != expected) ++open;
     }
     EXPECT_EQ(open, 0) << "trial " << trial;
   }
   EXPECT_GT(fills, 0u);
   EXPECT_GT(balanced, 0u) << "the test must reach cases balance changes";
+  EXPECT_GT(walled_frames, 5u) << "the test must reach eyes beyond the window";
+  EXPECT_LT(walled_frames, 30u) << "and eyes above it";
 }
 
 TEST(TerrainTree, RejectsBadWindowsAndLevels) {

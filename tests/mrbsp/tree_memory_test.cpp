@@ -38,12 +38,12 @@ Triangles random_triangles(std::uint32_t seed, int count) {
 
 float hills(int i, int j) { return 200.0f + 120.0f * std::sin(0.5f * static_cast<float>(i)) * std::cos(0.4f * static_cast<float>(j)); }
 
-TEST(TerrainTreeMemory, VerticesAreTheLattice) {
+TEST(TerrainTreeMemory, VerticesAreTheLatticeAndItsWalls) {
   const TestWindow w(16, hills);
   const TerrainTree tree(w.view(), 4);
   const MemoryStats m = tree.memory();
   EXPECT_EQ(m.samples, 17u * 17u);
-  EXPECT_EQ(m.vertices, 17u * 17u * sizeof(glm::vec3));
+  EXPECT_EQ(m.vertices, (17u * 17u + 8u * 17u) * sizeof(glm::vec3)) << "the samples, and a top and bottom per side sample";
   EXPECT_EQ(m.merged, 0u) << "nothing merged yet";
   EXPECT_GT(m.nodes, 0u);
   EXPECT_EQ(m.total(), m.nodes + m.vertices + m.merged);

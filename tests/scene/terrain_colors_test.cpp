@@ -55,15 +55,16 @@ TEST(TerrainColors, SlopesFacingTheSunAreBrighterThanSlopesFacingAway) {
   EXPECT_GE(shade(l, east).shade[12], static_cast<float>(east.ambient) - 1e-6f);
 }
 
-TEST(TerrainColors, SkirtBottomsTakeTheColourOfTheSampleAbove) {
+TEST(TerrainColors, WallVerticesTakeTheWallColourAndNoTexture) {
   const auto l = lattice([](double x, double y) { return static_cast<float>(x + 2 * y); });
   const auto s = shade(l);
   const std::vector<glm::u8vec4> merged{{1, 2, 3, 128}};
-  const auto v = vertex_shading(s, 3 * 25, merged);
-  ASSERT_EQ(v.rgba.size(), 3u * 25 + 1);
-  for (std::size_t k = 0; k < 25; ++k) {
-    EXPECT_EQ(v.rgba[25 + k], s.rgba[k]);
-    EXPECT_EQ(v.rgba[50 + k], s.rgba[k]);
+  const auto v = vertex_shading(s, 25 + 40, merged);  // a 4-cell window's lattice and walls
+  ASSERT_EQ(v.rgba.size(), 25u + 40 + 1);
+  for (std::size_t k = 0; k < 25; ++k) EXPECT_EQ(v.rgba[k], s.rgba[k]);
+  for (std::size_t k = 25; k < 65; ++k) {
+    EXPECT_EQ(v.rgba[k], kWallColor);
+    EXPECT_LT(v.tcoords[k].x, 0.0f) << "the renderer draws the wall's own colour";
   }
   EXPECT_EQ(v.rgba.back(), (Rgba{1, 2, 3, 128}));
 }

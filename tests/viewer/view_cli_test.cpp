@@ -835,11 +835,27 @@ TEST(ViewCli, HelpListsTheKeyBindings) {
   }
 }
 
-TEST(ViewCli, ACameraOutsideTheDemFailsWithOneLine) {
-  const auto r = test::run_terravol("view " + bundled_dem() + " --camera 47.5,6.5,4000,0,0");
+TEST(ViewCli, ACameraFarBeyondTheDemFailsWithOneLine) {
+  const auto r = test::run_terravol("view " + bundled_dem() + " --camera 48.5,6.5,4000,0,0");
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.err.find("terravol: camera 47.50000 N"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("terravol: camera 48.50000 N, 6.50000 E is 278.0 km beyond the DEM"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(ViewCli, ACameraBeyondTheDemSeesTheTileAndFlyingAwayStopsAt200Km) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  // 11 km south of the tile, looking north over it; then backwards (south) at 1000 heights per
+  // second, far faster than 200 km in a few seconds.
+  Viewer v(bundled_dem() + " --camera 44.9,6.5,4000,0,-10 --speed 1000" + kSmall);
+  ASSERT_TRUE(v.start());
+  const json s0 = v.settle();
+  EXPECT_GT(s0["triangles"].get<long>(), 1000) << "the tile is drawn";
+  ASSERT_TRUE(v.hold_until(
+      "s", [](const json& s) { return s["camera"]["lat"].get<double>() < 43.21; }, 40.0))
+      << "last status " << v.status().dump();
+  v.hold_until("s", [](const json&) { return false; }, 1.0);  // on against the limit for a second
+  const json s1 = v.settle();
+  EXPECT_NEAR(s1["camera"]["lat"].get<double>(), 45.0 - 199.8 / 111.2, 1e-3) << "stopped 200 km south of the tile";
 }
 
 }  // namespace
