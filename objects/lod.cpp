@@ -6,6 +6,7 @@
 
 #include <vtkCellArray.h>
 #include <vtkNew.h>
+#include <vtkObject.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataPointSampler.h>
@@ -106,6 +107,13 @@ std::vector<Lod> make_lods(const volume::Mesh& full, const LodOptions& options) 
   if (options.levels < 1 || !(options.ratio > 0.0 && options.ratio < 1.0)) {
     throw std::invalid_argument("make_lods: levels must be >= 1 and ratio within (0, 1)");
   }
+  // VTK's reductions warn on stderr ("Unable to factor linear system") where a bin's or an
+  // edge's quadric is singular, which they then handle; library code does not print.
+  struct QuietVtk {
+    int was = vtkObject::GetGlobalWarningDisplay();
+    QuietVtk() { vtkObject::GlobalWarningDisplayOff(); }
+    ~QuietVtk() { vtkObject::SetGlobalWarningDisplay(was); }
+  } quiet;
   std::vector<Lod> lods;
   lods.push_back({full, 0.0, 0.0});
   double budget = static_cast<double>(full.triangle_count());
