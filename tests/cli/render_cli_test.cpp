@@ -212,6 +212,16 @@ TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   expect_clean_failure(std::string(TERRAVOL_SOURCE_DIR) + "/missing.hgt --camera 45.5,6.5,3000,0,-10", "missing.hgt");
 }
 
+TEST(RenderCli, BadObjectsFailCleanlyWithOneLine) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const std::string view = bundled_dem() + " --camera 45.5,6.5,3000,0,-10 --object ";
+  expect_clean_failure(view + "truck.glb", "--object 'truck.glb': expected FILE@LAT,LON,AGL");
+  expect_clean_failure(view + "truck.glb@45.5,6.5,0,scale=0", "scale");
+  expect_clean_failure(view + std::string(TERRAVOL_SOURCE_DIR) + "/missing.glb@45.5,6.5,0", "missing.glb: no such file");
+  // A file that is no model: the DEM itself.
+  expect_clean_failure(view + bundled_dem() + "@45.5,6.5,0", bundled_dem() + ": ");
+}
+
 TEST(RenderCli, CameraBelowTheGroundOrBadLevelsFailCleanly) {
   TERRAVOL_REQUIRE_DISPLAY();
   const std::string dem = bundled_dem();
