@@ -82,6 +82,13 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
   // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
   volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), options_.surface_triangles, options_.markers);
   volumes_.merge_into(*scene_);
+  for (const scene::ObjectSpec& o : scene.objects) {
+    if (!scene::inside(mosaic_, scene::lattice_point(mosaic_, o.pose.lat, o.pose.lon))) {
+      char b[96];
+      std::snprintf(b, sizeof b, ": placed at %.5f, %.5f, outside the DEM", o.pose.lat, o.pose.lon);
+      throw std::invalid_argument(o.file.string() + b);
+    }
+  }
   objects_ = scene::ObjectLayer(
       scene.objects, [this](double lat, double lon) { return ground_height(lat, lon); }, scene_->frame(), options_.lod);
   lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),

@@ -88,8 +88,9 @@ class SceneRenderer {
   // the levels its camera asks for; scene::ObjectLayer) (scene.dems is not read: the mosaic is
   // given). settings.gradient: the sky follows
   // each frame's pitch. Throws std::runtime_error when the camera is outside the mosaic or
-  // without an X display, io::FormatError for bad DEM or volume files and std::invalid_argument
-  // for bad styles (a slice outside its volume, a bad level count, ...).
+  // without an X display, io::FormatError for bad DEM, volume or model files and
+  // std::invalid_argument for bad styles (a slice outside its volume, a bad level count, ...)
+  // and objects placed outside the mosaic or too large (scene::ObjectLayer).
   SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
                 const SceneOptions& options = {});
   // The same, opening the mosaic of scene.dems.

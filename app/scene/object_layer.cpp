@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,16 @@
 #include "objects/placement.h"
 
 namespace terravol::app::scene {
+
+namespace {
+
+std::string format_scale(double s) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", s);
+  return b;
+}
+
+}  // namespace
 
 std::uint32_t object_surface_id(std::size_t instance) {
   return static_cast<std::uint32_t>((instance >> 14) << 16 | 3u << 14 | (instance & 0x3fff));
@@ -75,6 +86,12 @@ ObjectLayer::ObjectLayer(const std::vector<ObjectSpec>& specs, const GroundFunct
     for (const glm::dvec3& v : m.model.mesh.vertices) {
       lo = glm::min(lo, objects::body_of(v, in->pose.up));
       hi = glm::max(hi, objects::body_of(v, in->pose.up));
+    }
+    const double across = glm::length(hi - lo) * in->pose.scale;
+    if (across > kMaxObjectMetres) {
+      throw std::invalid_argument(spec.file.string() + ": " + std::to_string(static_cast<long long>(across / 1000.0)) +
+                                  " km across at scale " + format_scale(in->pose.scale) + ", larger than " +
+                                  std::to_string(static_cast<int>(kMaxObjectMetres / 1000.0)) + " km");
     }
     volume::Mesh box;
     for (int c = 0; c < 8; ++c) {

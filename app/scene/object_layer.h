@@ -41,6 +41,10 @@ std::uint32_t object_surface_id(std::size_t instance);
 // colour cube (objects::color_cube; Chamberlain et al. 1995).
 inline constexpr double kColorCubePixels = 1.0;
 
+// The largest instance placed: its box's diagonal times its scale, metres (a model in
+// millimetres given scale 1000 by mistake would otherwise cover the window).
+inline constexpr double kMaxObjectMetres = 50'000.0;
+
 struct ObjectFigures {
   std::size_t models = 0, instances = 0;
   std::size_t full_triangles = 0;   // every instance at level 0
@@ -60,7 +64,8 @@ class ObjectLayer {
   // Reads every distinct model file once, makes its levels (`lod`) and its colour cube, and
   // works out where each instance stands (`ground` for heights above ground). Nothing is
   // merged until update(). Throws io::FormatError("FILE: ...") for a model that cannot be read
-  // and std::invalid_argument("FILE: ...") for a pose out of range.
+  // and std::invalid_argument("FILE: ...") for a pose out of range or an instance more than
+  // kMaxObjectMetres across.
   ObjectLayer(const std::vector<ObjectSpec>& specs, const GroundFunction& ground, const io::SceneFrame& frame,
               const objects::LodOptions& lod = {});
   ~ObjectLayer();
