@@ -1,7 +1,8 @@
 // Levels of detail for general objects (Wiley et al. 1997, section 6: a set of LOD models per
 // object, the paper's made by hierarchical vertex clustering, Schaufler and Stürzlinger 1995).
-// The reductions are volume/reduction.h's VTK methods; the error is VTK's Hausdorff filter on
-// sampled surfaces; the colour cube (Chamberlain et al. 1995) is twelve triangles, by hand.
+// The reductions are volume/reduction.h's VTK methods; the error is the Hausdorff distance
+// between surfaces sampled by VTK (vtkPolyDataPointSampler, vtkStaticCellLocator); the colour
+// cube (Chamberlain et al. 1995) is twelve triangles, by hand.
 #include "objects/lod.h"
 
 #include <vtkCellArray.h>
