@@ -33,7 +33,7 @@ struct BenchOptions {
   std::vector<std::filesystem::path> dems;
   std::filesystem::path under_test;
   std::string exactness_views;
-  std::string suites = "terrain,translucency,scaling,build,exactness,rf";
+  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects";
   int views = 0, repeats = 0;
 };
 
@@ -85,13 +85,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build, exactness, rf)");
+                               "' (terrain, translucency, scaling, build, exactness, rf, objects)");
     }
     out.insert(s);
   }
@@ -185,6 +185,17 @@ void run_bench(const BenchOptions& o, const std::string& command) {
         c.log("exactness: no scene for " + t.name + " (only the shared N44W072 and Utah terrains have one)");
       }
     }
+  if (suites.count("objects")) {
+    const std::filesystem::path models = "/usr/share/assimp/models";
+    const auto truck = models / "glTF/CesiumMilkTruck/CesiumMilkTruck.gltf", wuson = models / "PLY/Wuson.ply";
+    if (!std::filesystem::exists(truck) || !std::filesystem::exists(wuson)) {
+      c.log("assimp-testmodels is not installed: the objects suite is skipped (apt-get install assimp-testmodels)");
+    } else if (real.empty() || real.front().name != "n44w072") {
+      c.log("objects: the suite draws over the shared N44W072 tile, which is absent: skipped");
+    } else {
+      results["objects"] = object_suite(c, real.front(), truck, wuson);
+    }
+  }
   if (suites.count("scaling")) {
     // One tile, the six Utah tiles when there, and 16 tiles of the project's own generator.
     const auto tiles = c.cache / "tiles";
@@ -230,7 +241,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects")->capture_default_str();
   cmd->add_option("--under-test", o->under_test,
                   "The terravol executable whose render the exactness suite measures (default: this one)")
       ->check(CLI::ExistingFile);

@@ -564,4 +564,176 @@ json rf_suite(const BenchConfig& c, const std::filesystem::path& sdf, const volu
   return out;
 }
 
+
+namespace {
+
+// The objects suite's layouts (section 7.2 and issue 16's 200 instances).
+struct ObjectLayout {
+  std::string name;
+  std::vector<app::scene::ObjectSpec> objects;
+  std::vector<View> views;
+  double lat = 0, lon = 0;
+};
+
+app::scene::ObjectSpec object_at(const std::filesystem::path& file, double lat, double lon, double heading,
+                                 double scale) {
+  app::scene::ObjectSpec o;
+  o.file = file;
+  o.pose.lat = lat;
+  o.pose.lon = lon;
+  o.pose.heading_deg = heading;
+  o.pose.scale = scale;
+  return o;
+}
+
+// Bytes of a mesh as a model file holds it: float positions and RGBA per vertex, 32-bit indices.
+std::size_t mesh_bytes(const volume::Mesh& m) { return m.vertices.size() * 16 + m.triangles.size() * 4; }
+
+std::vector<ObjectLayout> object_layouts(const BenchConfig& c, const std::filesystem::path& truck,
+                                         const std::filesystem::path& wuson) {
+  const double lat = 44.27, lon = -71.30;
+  const double m_lat = 1.0 / 111130.0, m_lon = 1.0 / (111320.0 * std::cos(lat * M_PI / 180.0));  // degrees per metre
+  std::vector<ObjectLayout> out;
+  // Eight milk trucks (5 m long) in two rows of four, 15 m apart, seen from 40 m to 600 m.
+  ObjectLayout eight{"eight-trucks", {}, {}, lat, lon};
+  for (int k = 0; k < 8; ++k) {
+    eight.objects.push_back(object_at(truck, lat + (k / 4 - 0.5) * 15 * m_lat, lon + (k % 4 - 1.5) * 15 * m_lon, 40.0 * k, 1.0));
+  }
+  const int per_range = std::max(1, c.volume_views / 4);
+  for (const double km : {0.04, 0.12, 0.3, 0.6}) {
+    for (const View& v : orbit(lat, lon, km, 25.0 + 60.0 * km, -8.0, per_range)) eight.views.push_back(v);
+  }
+  out.push_back(std::move(eight));
+  // 200 instances, trucks and Wuson alternately, scaled to about 15 m, scattered over 4 x 4 km
+  // (seeded), seen from 0.3 to 3 km.
+  ObjectLayout many{"200-instances", {}, {}, lat, lon};
+  std::uint32_t seed = 16;
+  const auto next = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) / 16777216.0;
+  };
+  for (int k = 0; k < 200; ++k) {
+    const double dy = (next() - 0.5) * 4000, dx = (next() - 0.5) * 4000, heading = 360.0 * next();
+    many.objects.push_back(object_at(k % 2 ? wuson : truck, lat + dy * m_lat, lon + dx * m_lon, heading, k % 2 ? 4.5 : 3.0));
+  }
+  for (const double km : {0.3, 1.0, 3.0}) {
+    for (const View& v : orbit(lat, lon, km, 60.0 + 100.0 * km, -6.0, std::max(1, c.volume_views / 3))) many.views.push_back(v);
+  }
+  out.push_back(std::move(many));
+  return out;
+}
+
+}  // namespace
+
+json object_suite(const BenchConfig& c, const Terrain& terrain, const std::filesystem::path& truck,
+                  const std::filesystem::path& wuson) {
+  json list = json::array();
+  for (const ObjectLayout& layout : object_layouts(c, truck, wuson)) {
+    say(c, "objects " + layout.name + ": reading the models, making their levels");
+    app::scene::SceneSpec spec = terrain_spec(terrain, layout.lat, layout.lon);
+    spec.objects = layout.objects;
+    const mrbsp::TraversalOptions traversal = lod(mrbsp::LodMetric::kError, 2.0);
+    app::render::SceneRenderer chosen(spec, plain_settings(c), bench_scene_options(512));
+    app::render::SceneRenderer full(spec, plain_settings(c), bench_scene_options(512));
+    full.objects().set_fixed_level(0);
+    app::scene::SceneSpec bare_spec = spec;
+    bare_spec.objects.clear();
+    app::render::SceneRenderer bare(bare_spec, plain_settings(c), bench_scene_options(512));  // the terrain alone
+    std::unique_ptr<PlainVtkScene> plain;
+    std::vector<double> lod_ms, full_ms, plain_ms, ratio_full, ratio_plain, psnr_db, switch_ms, lod_tris;
+    std::vector<double> lod_added, full_added;
+    json views = json::array();
+    double merged_ratio = 0;
+    for (const View& v : layout.views) {
+      // Untimed first frames: each renderer merges the levels this view asks for.
+      const app::render::FrameStats first = chosen.render(v.pose, true, 45.0, traversal);
+      full.render(v.pose, true, 45.0, traversal);
+      bare.render(v.pose, true, 45.0, traversal);
+      if (!plain) {
+        plain = plain_scene(full, full.objects().visible_mesh(), Translucency::kPeel4, c);
+      }
+      plain->set_camera(full.camera(), far_plane(full));
+      plain->render();
+      std::vector<double> a, b, p, t;
+      app::render::FrameStats s;
+      for (int r = 0; r < c.repeats; ++r) {
+        s = chosen.render(v.pose, true, 45.0, traversal);
+        a.push_back(frame_ms(s) + s.objects_ms);  // the levels' choice (and any re-merge) counts
+        const app::render::FrameStats f = full.render(v.pose, true, 45.0, traversal);
+        b.push_back(frame_ms(f) + f.objects_ms);
+        p.push_back(plain->render());
+        t.push_back(frame_ms(bare.render(v.pose, true, 45.0, traversal)));
+      }
+      const double ma = median(a), mb = median(b), mp = median(p), mt = median(t);
+      // What the objects add to the terrain's frame: a difference of two noisy times, so only
+      // its median over the views is compared (objects_added_full_over_lod).
+      lod_added.push_back(ma - mt);
+      full_added.push_back(mb - mt);
+      const double q = psnr(chosen.rgb(), full.rgb(), c.width, c.height);
+      lod_ms.push_back(ma);
+      full_ms.push_back(mb);
+      plain_ms.push_back(mp);
+      ratio_full.push_back(mb / ma);
+      ratio_plain.push_back(mp / ma);
+      psnr_db.push_back(std::isinf(q) ? 99.0 : q);
+      switch_ms.push_back(first.objects_ms);
+      lod_tris.push_back(static_cast<double>(chosen.objects().figures().chosen_triangles));
+      // The tree's storage of the merged objects against the chosen levels' own bytes.
+      std::size_t own = 0;
+      for (std::size_t i = 0; i < chosen.objects().size(); ++i) own += mesh_bytes(chosen.objects().placed(i, chosen.objects().level_of(i)));
+      merged_ratio = static_cast<double>(chosen.terrain().tree().memory().merged) / static_cast<double>(own);
+      views.push_back({{"range_m", std::hypot(v.pose.lat - layout.lat, (v.pose.lon - layout.lon) * std::cos(layout.lat * M_PI / 180.0)) * 111130.0},
+                       {"lod_ms", ma},
+                       {"full_ms", mb},
+                       {"plain_ms", mp},
+                       {"terrain_alone_ms", mt},
+                       {"psnr_db", q},
+                       {"object_triangles_lod", chosen.objects().figures().chosen_triangles},
+                       {"object_triangles_full", chosen.objects().figures().full_triangles},
+                       {"colour_cubes", chosen.objects().figures().cubes},
+                       {"frame_triangles_lod", s.triangles},
+                       {"merge_on_arrival_ms", first.objects_ms},
+                       {"remerged_on_arrival", first.objects_merged},
+                       {"tree_merged_over_own_bytes", merged_ratio}});
+      char line[240];
+      std::snprintf(line, sizeof line,
+                    "objects %s: view %zu: LOD %.1f ms (%zu object triangles), full %.1f ms, terrain alone %.1f ms, "
+                    "plain VTK %.1f ms, PSNR %.1f dB",
+                    layout.name.c_str(), views.size(), ma, chosen.objects().figures().chosen_triangles, mb, mt, mp, q);
+      say(c, line);
+    }
+    json models = json::array();
+    for (std::size_t m = 0; m < chosen.objects().figures().models; ++m) {
+      json levels = json::array();
+      std::size_t bytes = 0;
+      for (const objects::Lod& l : chosen.objects().levels(m)) {
+        levels.push_back({{"triangles", l.mesh.triangle_count()}, {"hausdorff", l.hausdorff}, {"error", l.error}});
+        bytes += mesh_bytes(l.mesh);
+      }
+      models.push_back({{"levels", levels}, {"bytes_all_levels", bytes}, {"bytes_full", mesh_bytes(chosen.objects().levels(m).front().mesh)}});
+    }
+    const app::scene::ObjectFigures& f = chosen.objects().figures();
+    list.push_back({{"terrain", terrain.name},
+                    {"layout", layout.name},
+                    {"instances", f.instances},
+                    {"full_triangles", f.full_triangles},
+                    {"read_ms", f.read_ms},
+                    {"lod_ms_to_make", f.lod_ms},
+                    {"models", models},
+                    {"lod_frame_ms", to_json(summarize(lod_ms))},
+                    {"full_frame_ms", to_json(summarize(full_ms))},
+                    {"plain_frame_ms", to_json(summarize(plain_ms))},
+                    {"full_over_lod", to_json(summarize(ratio_full))},
+                    {"objects_added_lod_ms", to_json(summarize(lod_added))},
+                    {"objects_added_full_ms", to_json(summarize(full_added))},
+                    {"objects_added_full_over_lod", median(full_added) / std::max(median(lod_added), 0.1)},
+                    {"plain_over_lod", to_json(summarize(ratio_plain))},
+                    {"psnr_db", to_json(summarize(psnr_db))},
+                    {"merge_on_arrival_ms", to_json(summarize(switch_ms))},
+                    {"object_triangles_lod", to_json(summarize(lod_tris))},
+                    {"views", views}});
+  }
+  return list;
+}
+
 }  // namespace terravol::bench

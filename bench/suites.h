@@ -89,4 +89,19 @@ nlohmann::json exactness_suite(const BenchConfig& config, const Terrain& terrain
 nlohmann::json rf_suite(const BenchConfig& config, const std::filesystem::path& sdf_folder,
                         const volume::Transmitter& transmitter, int splat_heights);
 
+// 9. Objects on the terrain (issue 16; Wiley et al. 1997, section 7.2): eight milk trucks
+// (`truck`, assimp-testmodels' glTF CesiumMilkTruck, 3,624 triangles) seen from 40 to 600 m, and
+// 200 instances of the truck and of `wuson` (PLY, 3,732 triangles) scattered over 4 x 4 km of
+// the terrain, seen from 0.3 to 3 km, in a 512-cell window. Per view, side by side: the
+// pipeline with each instance's level chosen per frame (2 px of screen-space error, colour cubes
+// below a pixel), the same pipeline with every instance at full resolution (its own tree, so
+// neither re-merges between the timed frames), and plain VTK drawing the window's
+// full-resolution lattice with every instance at full resolution (4 peels); frame times (the
+// level choice included), their ratios, PSNR of the chosen levels' image against the full
+// resolution one, the object triangles drawn, the cost of the first frame of a view (the
+// re-merge of the instances whose level changed), the tree's bytes for the merged objects over
+// the chosen levels' own, and each model's levels (triangles, Hausdorff errors).
+nlohmann::json object_suite(const BenchConfig& config, const Terrain& terrain, const std::filesystem::path& truck,
+                            const std::filesystem::path& wuson);
+
 }  // namespace terravol::bench

@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "app/cli/commands.h"
+#include "app/cli/scene_options.h"
 #include "app/output/frame_sink.h"
 #include "app/output/write_file.h"
 #include "app/render/scene_renderer.h"
@@ -48,6 +49,7 @@ struct FlyOptions {
   int crf = 20;
   int samples = 1;
   bool resume = false, force = false;
+  std::vector<std::string> objects;  // --object, added to the scene's
 };
 
 bool is_video(const std::filesystem::path& p) {
@@ -96,6 +98,7 @@ void run_fly(const FlyOptions& o) {
   for (const auto& v : scene.volumes) {
     if (!std::filesystem::exists(v.file)) throw std::invalid_argument(source + ": scene: " + v.file.string() + ": no such file");
   }
+  for (scene::ObjectSpec& obj : parse_objects(o.objects)) scene.objects.push_back(std::move(obj));
   // Size and LOD: --size and --threshold over the scene's "render" object over the defaults.
   scene::SceneStyle given;
   if (!o.size.empty()) {
@@ -336,6 +339,7 @@ void add_fly_command(CLI::App& app) {
   auto* start = cmd->add_option("--start", raw->start, "First time to export, seconds on the path's clock");
   auto* end = cmd->add_option("--end", raw->end, "Last time to export, seconds on the path's clock");
   cmd->add_option("--stats", o->stats, "Per-frame figures (CSV)");
+  add_object_option(*cmd, o->objects);
   cmd->add_flag("--resume", o->resume, "Continue a PNG export from its first missing frame");
   cmd->add_flag("--force", o->force, "Replace existing outputs");
   cmd->add_option("--samples", o->samples,

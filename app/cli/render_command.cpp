@@ -54,6 +54,7 @@ struct RenderOptions {
   std::filesystem::path stats;     // JSON, optional
   std::filesystem::path export_vtp;  // optional
   std::vector<scene::VolumeSpec> volumes;  // RF volumes and their styles
+  std::vector<scene::ObjectSpec> objects;  // models placed on the terrain
 };
 
 void run_render(const RenderOptions& o) {
@@ -89,6 +90,7 @@ void run_render(const RenderOptions& o) {
   scene::SceneSpec scene;
   scene.dems = o.dems;
   scene.volumes = o.volumes;
+  scene.objects = o.objects;
   scene.camera = scene::SceneCamera{o.pose, o.agl, o.fov_y_deg};
   const auto t_scene = Clock::now();
   render::SceneRenderer view(scene, settings, render::scene_options(st, o.levels));
@@ -106,6 +108,13 @@ void run_render(const RenderOptions& o) {
     std::printf("volumes: %zu triangles extracted in %.0f ms, %zu in the tree after a %.0f ms merge; %zu of %zu drawn\n",
                 merge.input_triangles, merge.geometry_ms, merge.tree_triangles, merge.merge_ms, f.merged_triangles,
                 f.triangles);
+  }
+  const scene::ObjectFigures& objects = view.objects().figures();
+  if (objects.instances > 0) {
+    std::printf("objects: %zu instances of %zu models read in %.0f ms, levels made in %.0f ms; %zu of %zu triangles "
+                "chosen (%zu colour cubes)\n",
+                objects.instances, objects.models, objects.read_ms, objects.lod_ms, objects.chosen_triangles,
+                objects.full_triangles, objects.cubes);
   }
   if (!o.export_vtp.empty()) {
     render::TerrainRenderer& r = view.renderer();
@@ -153,6 +162,15 @@ void run_render(const RenderOptions& o) {
                     {"merged_bytes", tree.memory().merged},
                     {"geometry_ms", merge.geometry_ms},
                     {"merge_ms", merge.merge_ms}};
+    j["objects"] = {{"models", objects.models},
+                    {"instances", objects.instances},
+                    {"full_triangles", objects.full_triangles},
+                    {"chosen_triangles", objects.chosen_triangles},
+                    {"lod_triangles", objects.lod_triangles},
+                    {"colour_cubes", objects.cubes},
+                    {"read_ms", objects.read_ms},
+                    {"lod_ms", objects.lod_ms},
+                    {"first_merge_ms", first.objects_ms}};
     j["camera"] = {{"lat", o.pose.lat},
                    {"lon", o.pose.lon},
                    {"eye_height", f.eye_height},
@@ -215,6 +233,7 @@ void add_render_command(CLI::App& app) {
     opt.pose = *pose;
     opt.style = scene::resolve_style(file.style);
     opt.volumes = file.volumes;
+    opt.objects = file.objects;
     if (!raw->background.empty()) opt.background = scene::parse_rgb("--background", raw->background);
     scene::check_view_options(opt.fov_y_deg, opt.style, levels->count() > 0, opt.levels);
     run_render(opt);

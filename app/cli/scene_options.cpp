@@ -22,6 +22,7 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
   cmd.add_option("--slice", args.slices,
                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
                  "repeatable");
+  add_object_option(cmd, args.objects);
   cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
   cmd.add_flag("--no-markers", args.no_markers, "No marker at the transmitters the volumes record");
 
@@ -69,6 +70,19 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
                               "conservative; with --occlusion on");
 }
 
+CLI::Option* add_object_option(CLI::App& cmd, std::vector<std::string>& objects) {
+  return cmd.add_option("--object", objects,
+                        "3D model (glTF, OBJ, PLY, STL, FBX, ... read by assimp) placed on the terrain: "
+                        "FILE@LAT,LON,AGL[,heading=DEG][,pitch=DEG][,roll=DEG][,scale=S][,opacity=A][,up=y|z] "
+                        "(AGL metres above the ground; docs/scene-file.md, \"objects\"); repeatable");
+}
+
+std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts) {
+  std::vector<scene::ObjectSpec> out;
+  for (const std::string& t : texts) out.push_back(scene::parse_object(t));
+  return out;
+}
+
 scene::SceneStyle given_style(const SceneArgs& args) {
   const StyleArgs& s = args.style;
   const auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
@@ -114,6 +128,7 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
   for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
   std::vector<volume::SliceSpec> slice_specs;
   for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
+  for (scene::ObjectSpec& o : parse_objects(args.objects)) scene.objects.push_back(std::move(o));
   if (args.volumes.empty()) {
     for (scene::VolumeSpec& v : scene.volumes) {
       if (!iso_specs.empty()) v.isosurfaces = iso_specs;

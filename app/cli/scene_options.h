@@ -29,17 +29,22 @@ struct StyleArgs {
               *occlusion_option = nullptr, *coherence_option = nullptr;
 };
 
-// The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --no-legend
-// and the style options.
+// The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --object,
+// --no-legend and the style options.
 struct SceneArgs {
   std::filesystem::path scene;
   std::vector<std::filesystem::path> volumes;
-  std::vector<std::string> isos, slices;
+  std::vector<std::string> isos, slices, objects;
   std::string volume_frame, field;
   bool no_legend = false, no_markers = false;
   StyleArgs style;
 };
 void add_scene_options(CLI::App& cmd, SceneArgs& args);
+// --object FILE@LAT,LON,AGL[,heading=..][,pitch=..][,roll=..][,scale=..][,opacity=..][,up=y|z]
+// (render, view and fly share it).
+CLI::Option* add_object_option(CLI::App& cmd, std::vector<std::string>& objects);
+// The scene objects of --object texts (scene::parse_object; the files are read later).
+std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts);
 
 // The style keys the command line gave: each style option given, and legend false with
 // --no-legend. Throws std::invalid_argument for a bad --size.
@@ -50,8 +55,9 @@ scene::SceneStyle given_style(const SceneArgs& args);
 // its style overlaid with given_style (the options win), and its volumes joined with the
 // --volume files: each --volume FILE (read as --field, placed by --volume-frame) gets the
 // --iso and --slice styles; with no --volume, non-empty --iso or --slice lists replace the
-// styles of every volume of the file. Throws std::invalid_argument for a bad file or bad
-// --iso, --slice, --volume-frame or --size text.
+// styles of every volume of the file; each --object (scene::parse_object) joins the file's
+// objects. Throws std::invalid_argument for a bad file or bad --iso, --slice, --object,
+// --volume-frame or --size text.
 scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
 
 }  // namespace terravol::app::cli

@@ -54,6 +54,7 @@ void add_view_command(CLI::App& app) {
                                      opt.fov_y_deg);
     opt.style = scene::resolve_style(file.style);
     opt.volumes = file.volumes;
+    opt.objects = file.objects;
     opt.auto_slide = !raw->no_slide;
     scene::check_view_options(opt.fov_y_deg, opt.style, levels->count() > 0, opt.levels);
     if (!(opt.flight.speed_factor > 0.0) || !std::isfinite(opt.flight.speed_factor)) {

@@ -82,6 +82,15 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
   // Volumes: read once, placed in the scene frame (fixed for the session: slides keep it).
   volumes_ = scene::VolumeLayer(scene.volumes, mosaic_, scene_->frame(), options_.surface_triangles, options_.markers);
   volumes_.merge_into(*scene_);
+  for (const scene::ObjectSpec& o : scene.objects) {
+    if (!scene::inside(mosaic_, scene::lattice_point(mosaic_, o.pose.lat, o.pose.lon))) {
+      char b[96];
+      std::snprintf(b, sizeof b, ": placed at %.5f, %.5f, outside the DEM", o.pose.lat, o.pose.lon);
+      throw std::invalid_argument(o.file.string() + b);
+    }
+  }
+  objects_ = scene::ObjectLayer(
+      scene.objects, [this](double lat, double lon) { return ground_height(lat, lon); }, scene_->frame(), options_.lod);
   lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
                                   options_.shading);
   const mrbsp::TerrainTree& tree = scene_->tree();
@@ -227,9 +236,9 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
     }
     if (auto_slide_ && !pending_.valid()) {
       if (const auto next = next_window(pose)) {
-        // Without volumes the tree has no merged vertices, before the slide or after it: the
+        // Without volumes or objects the tree has no merged vertices, before the slide or after it: the
         // worker can make the vertices' shading with the lattice's.
-        const std::size_t terrain_vertices = volumes_.size() == 0 ? scene_->tree().merged_base() : 0;
+        const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
           return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
@@ -265,6 +274,10 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   }
 
   auto t0 = Clock::now();
+  objects_.update(*scene_, camera_, traversal);
+  stats.objects_ms = ms_since(t0);
+  stats.objects_merged = objects_.figures().remerged;
+  t0 = Clock::now();
   scene_->tree().traverse(camera_, traversal, frame_);
   stats.traversal_ms = ms_since(t0);
   t0 = Clock::now();
@@ -319,8 +332,10 @@ std::optional<Pick> SceneRenderer::pick(int x, int y) const {
   const auto inside = [&](double lat, double lon) { return lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east; };
   const auto ground = [&](double lat, double lon) { return scene_->ground_height(lat, lon); };
   const glm::dvec3 eye = camera_.eye;
+  volume::Mesh surfaces = volumes_.visible_mesh();
+  volume::append(surfaces, objects_.visible_mesh());
   const std::optional<scene::PickPoint> p = scene::pick(scene::pixel_ray(camera_, x, y), scene_->frame(), ground, inside,
-                                                        volumes_.visible_mesh(), scene_->far_plane(eye));
+                                                        surfaces, scene_->far_plane(eye));
   if (!p) return std::nullopt;
   Pick out;
   out.point = *p;

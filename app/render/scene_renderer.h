@@ -18,6 +18,7 @@
 
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera.h"
+#include "app/scene/object_layer.h"
 #include "app/scene/pick.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
@@ -37,6 +38,8 @@ struct FrameStats {
   int slides = 0;        // window slides so far (this frame's included)
   double slide_ms = 0;   // this frame's slide on the calling thread (re-merge included), 0 when none
   double eye_height = 0, ground_height = 0;  // metres, DEM datum
+  double objects_ms = 0;          // choosing the objects' levels and merging those that changed
+  std::size_t objects_merged = 0; // instances merged again this frame
 };
 
 // When the window slides, once the camera is within a quarter of its side of an edge.
@@ -52,6 +55,7 @@ struct SceneOptions {
   bool legend = true;     // a colour legend for the volumes
   bool markers = true;    // a marker at each transmitter the volumes record (VolumeLayer)
   std::size_t surface_triangles = scene::kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
+  objects::LodOptions lod;  // the objects' levels of detail (scene::ObjectLayer)
   Sliding sliding = Sliding::kSynchronous;
 };
 
@@ -80,10 +84,13 @@ class SceneRenderer {
  public:
   // Chooses the first window around scene.camera (else scene::default_pose(mosaic), above the
   // mosaic's centre), builds the tree, reads every volume and merges the visible ones'
-  // geometry (scene.dems is not read: the mosaic is given). settings.gradient: the sky follows
+  // geometry, reads every object's model and makes its levels (merged at the first frame, in
+  // the levels its camera asks for; scene::ObjectLayer) (scene.dems is not read: the mosaic is
+  // given). settings.gradient: the sky follows
   // each frame's pitch. Throws std::runtime_error when the camera is outside the mosaic or
-  // without an X display, io::FormatError for bad DEM or volume files and std::invalid_argument
-  // for bad styles (a slice outside its volume, a bad level count, ...).
+  // without an X display, io::FormatError for bad DEM, volume or model files and
+  // std::invalid_argument for bad styles (a slice outside its volume, a bad level count, ...)
+  // and objects placed outside the mosaic or too large (scene::ObjectLayer).
   SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
                 const SceneOptions& options = {});
   // The same, opening the mosaic of scene.dems.
@@ -98,8 +105,10 @@ class SceneRenderer {
   // Everything of a frame but the draw: slides the window first (see Sliding) when auto-slide is
   // on and the camera is within a quarter of the window's side of an edge, sets the camera (the
   // window's current size in pixels) and the sky, traverses the tree and replaces the triangle
-  // list. A camera beyond the mosaic is allowed (up to scene::kMaxKmBeyond): the window is then
-  // the part of the mosaic nearest it, with walls closing the sides it sees
+  // list. Before the traversal the objects' levels are chosen for the camera and the instances
+  // whose level changed merged again (scene::ObjectLayer::update, with `traversal`'s metric and
+  // threshold). A camera beyond the mosaic is allowed (up to scene::kMaxKmBeyond): the window is
+  // then the part of the mosaic nearest it, with walls closing the sides it sees
   // (mrbsp::TerrainTree::traverse()). Throws std::runtime_error when the camera is farther, or
   // not above the ground, and, with kSynchronous, io::FormatError when the moved window cannot
   // be read.
@@ -133,8 +142,8 @@ class SceneRenderer {
   std::vector<std::uint8_t> rgb() const;  // the last image: width * height * 3 bytes, top row first
 
   // The point under pixel (x, y) of the last frame (x from the left, y from the bottom: VTK's
-  // event positions), on the window's terrain or on the nearest isosurface or slice in front of
-  // it (scene::pick over visible_mesh()), with the ground under it and the visible volumes'
+  // event positions), on the window's terrain or on the nearest isosurface, slice or object in
+  // front of it (scene::pick over the volumes' and objects' visible_mesh()), with the ground under it and the visible volumes'
   // values there. Nothing when the pixel shows sky or lies beyond the window.
   std::optional<Pick> pick(int x, int y) const;
 
@@ -167,6 +176,10 @@ class SceneRenderer {
   // (what terravol view does after a key). Returns what the merge cost.
   scene::VolumeLayer& volumes() { return volumes_; }
   const scene::MergeFigures& remerge();
+  // The objects on the terrain (set_fixed_level for benchmarks and tests; takes effect at the
+  // next prepare()).
+  scene::ObjectLayer& objects() { return objects_; }
+  const scene::ObjectLayer& objects() const { return objects_; }
 
  private:
   // A moved window read from the mosaic (and, read ahead, shaded), ready to slide to.
@@ -194,6 +207,7 @@ class SceneRenderer {
   std::unique_ptr<scene::TerrainScene> scene_;
   scene::TerrainShading lattice_;
   scene::VolumeLayer volumes_;
+  scene::ObjectLayer objects_;
   std::unique_ptr<TerrainRenderer> renderer_;
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;

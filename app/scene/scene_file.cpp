@@ -7,6 +7,8 @@
 #include <iterator>
 #include <set>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "app/scene/json_reader.h"
 #include "app/scene/style.h"
@@ -109,6 +111,36 @@ VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, c
   return v;
 }
 
+// The ranges both the scene file and --object check.
+constexpr double kMaxObjectHeight = 1e5, kMaxScale = 1e6, kMaxAngle = 720.0;
+
+ObjectSpec object_of(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& base) {
+  r.only_keys(j, where, {"file", "lat", "lon", "height", "agl", "heading", "pitch", "roll", "scale", "opacity", "up"});
+  for (const char* key : {"file", "lat", "lon"}) r.required(j, where, key);
+  ObjectSpec o;
+  o.file = resolve(base, r.string(j["file"], Reader::join(where, "file")));
+  o.pose.lat = r.number(j["lat"], Reader::join(where, "lat"), -85.0, 85.0);
+  o.pose.lon = r.number(j["lon"], Reader::join(where, "lon"), -360.0, 360.0);
+  if (j.contains("height") && j.contains("agl")) r.fail(where, "give height (above the datum) or agl (above the ground), not both");
+  o.agl = !j.contains("height");
+  const char* h = o.agl ? "agl" : "height";
+  if (j.contains(h)) o.pose.height = r.number(j[h], Reader::join(where, h), -kMaxObjectHeight, kMaxObjectHeight);
+  if (j.contains("heading")) o.pose.heading_deg = r.number(j["heading"], Reader::join(where, "heading"), -kMaxAngle, kMaxAngle);
+  if (j.contains("pitch")) o.pose.pitch_deg = r.number(j["pitch"], Reader::join(where, "pitch"), -kMaxAngle, kMaxAngle);
+  if (j.contains("roll")) o.pose.roll_deg = r.number(j["roll"], Reader::join(where, "roll"), -kMaxAngle, kMaxAngle);
+  if (j.contains("scale")) {
+    o.pose.scale = r.number(j["scale"], Reader::join(where, "scale"), 0.0, kMaxScale);
+    if (!(o.pose.scale > 0.0)) r.fail(Reader::join(where, "scale"), "must be > 0");
+  }
+  if (j.contains("opacity")) o.opacity = r.number(j["opacity"], Reader::join(where, "opacity"), 0.0, 1.0);
+  if (j.contains("up")) {
+    const std::string up = r.string(j["up"], Reader::join(where, "up"));
+    if (up != "y" && up != "z") r.fail(Reader::join(where, "up"), "expected \"y\" or \"z\", got \"" + up + "\"");
+    o.pose.up = up == "y" ? objects::UpAxis::kY : objects::UpAxis::kZ;
+  }
+  return o;
+}
+
 SceneCamera camera_of(const Reader& r, const json& j) {
   r.only_keys(j, "camera", {"lat", "lon", "alt", "agl", "heading", "pitch", "fov"});
   SceneCamera c;
@@ -174,7 +206,7 @@ SceneStyle style_of(const Reader& r, const json& j) {
 
 SceneSpec parse_scene_json(const json& doc, const std::filesystem::path& base, const std::string& source) {
   const Reader r(source, "key");
-  r.only_keys(doc, "", {"dem", "volumes", "camera", "render"});
+  r.only_keys(doc, "", {"dem", "volumes", "objects", "camera", "render"});
   SceneSpec s;
   if (doc.contains("dem")) {
     const json& d = doc["dem"];
@@ -192,9 +224,64 @@ SceneSpec parse_scene_json(const json& doc, const std::filesystem::path& base, c
       s.volumes.push_back(volume_of(r, doc["volumes"][k], Reader::at("volumes", k), base));
     }
   }
+  if (doc.contains("objects")) {
+    if (!doc["objects"].is_array()) r.fail("objects", "expected a list");
+    for (std::size_t k = 0; k < doc["objects"].size(); ++k) {
+      s.objects.push_back(object_of(r, doc["objects"][k], Reader::at("objects", k), base));
+    }
+  }
   if (doc.contains("camera")) s.camera = camera_of(r, doc["camera"]);
   if (doc.contains("render")) s.style = style_of(r, doc["render"]);
   return s;
+}
+
+ObjectSpec parse_object(const std::string& text) {
+  const auto fail = [&](const std::string& what) -> void {
+    throw std::invalid_argument("--object '" + text + "': " + what);
+  };
+  const std::size_t at = text.rfind('@');
+  if (at == std::string::npos || at == 0) fail("expected FILE@LAT,LON,AGL[,heading=..][,scale=..]");
+  std::vector<std::string> parts;
+  for (std::size_t b = at + 1;;) {
+    const std::size_t e = text.find(',', b);
+    parts.push_back(text.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  if (parts.size() < 3) fail("expected LAT,LON,AGL after '@'");
+  // Built as the scene file's object and checked by the same code, so both accept the same values.
+  json j = json::object();
+  j["file"] = text.substr(0, at);
+  const char* numbers[] = {"lat", "lon", "agl"};
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    std::string key, value = parts[k];
+    if (k < 3) {
+      key = numbers[k];
+    } else {
+      const std::size_t eq = value.find('=');
+      if (eq == std::string::npos) fail("'" + value + "' is not KEY=VALUE");
+      key = value.substr(0, eq);
+      value = value.substr(eq + 1);
+      if (key != "heading" && key != "pitch" && key != "roll" && key != "scale" && key != "opacity" && key != "up") {
+        fail("unknown key '" + key + "' (known: heading, pitch, roll, scale, opacity, up)");
+      }
+      if (j.contains(key)) fail("'" + key + "' given twice");
+    }
+    if (key == "up") {
+      j[key] = value;
+      continue;
+    }
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != value.size()) fail("'" + value + "' is not a number");
+    j[key] = v;
+  }
+  return object_of(Reader("--object '" + text + "'", "key"), j, "", "");
 }
 
 SceneSpec load_scene_file(const std::filesystem::path& path) {

@@ -13,6 +13,7 @@
 
 #include "app/scene/camera.h"
 #include "app/scene/style.h"
+#include "objects/placement.h"
 #include "volume/geometry.h"
 
 namespace terravol::app::scene {
@@ -26,6 +27,21 @@ struct VolumeSpec {
   std::vector<volume::SliceSpec> slices;
 };
 
+// A model placed on the terrain (objects/). pose.height is metres above the ground under
+// (lat, lon) when agl, else above the DEM's datum; the model's anchor (objects::anchor_of: the
+// bottom centre of its box) stands there.
+struct ObjectSpec {
+  std::filesystem::path file;
+  objects::Pose pose;
+  bool agl = true;
+  double opacity = 1.0;  // [0, 1], times the model's own alphas
+};
+
+// Parses the command line's "FILE@LAT,LON,AGL[,heading=DEG][,pitch=DEG][,roll=DEG][,scale=S]
+// [,opacity=A][,up=y|z]" (heights above the ground). Throws std::invalid_argument("--object
+// 'TEXT': what is wrong", one line).
+ObjectSpec parse_object(const std::string& text);
+
 struct SceneCamera {
   CameraPose pose;
   bool agl = false;  // pose.alt is above the ground under the camera
@@ -35,6 +51,7 @@ struct SceneCamera {
 struct SceneSpec {
   std::vector<std::filesystem::path> dems;
   std::vector<VolumeSpec> volumes;
+  std::vector<ObjectSpec> objects;
   std::optional<SceneCamera> camera;
   SceneStyle style;  // the "render" object
 };

@@ -352,6 +352,7 @@ Viewer::Viewer(const ViewOptions& options)
   scene::SceneSpec spec;
   spec.dems = o_.dems;
   spec.volumes = o_.volumes;
+  spec.objects = o_.objects;
   spec.camera = scene::SceneCamera{pose_, agl, o_.fov_y_deg};
   render::RenderSettings settings = render::render_settings(o_.style);
   settings.lod_colors = lod_colors_;

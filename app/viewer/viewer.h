@@ -33,6 +33,7 @@ struct ViewOptions {
   // name and renamed); empty: none.
   std::filesystem::path status;
   std::vector<scene::VolumeSpec> volumes;  // RF volumes and their styles
+  std::vector<scene::ObjectSpec> objects;  // models placed on the terrain (--object, the scene file's)
   std::filesystem::path scene_file;  // the --scene file, if any (a recorded path refers to it)
   // Where the save-path key writes the recorded keyframes (a camera path for terravol fly,
   // atomically, replaced each time); empty: terravol-path.json in the current folder.

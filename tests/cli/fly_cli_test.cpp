@@ -257,6 +257,41 @@ TEST(FlyCli, BadPathFilesFailWithOneLineBeforeAnyFrame) {
   expect_rejected(dir, flight().dump(), "out.avi: not a video", "", "out.avi");
 }
 
+// --object places models along the flight: a 400 m magenta box floating 800 m above the ground
+// 1.2 km ahead of the first key shows in its frame (faded a little by the haze), and not without
+// it; bad ones fail first.
+TEST(FlyCli, ObjectsAppearInTheFramesAndBadOnesFailBeforeAnyFrame) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto box = dir.path() / "box.obj";
+  std::ofstream(dir.path() / "box.mtl") << "newmtl m\nKd 1 0 1\n";
+  {
+    std::ofstream o(box);
+    o << "mtllib box.mtl\n";
+    for (int c = 0; c < 8; ++c) o << "v " << (c & 1 ? 200 : -200) << " " << (c & 2 ? 400 : 0) << " " << (c & 4 ? 200 : -200) << "\n";
+    o << "usemtl m\nf 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  }
+  const auto path = write_path(dir, flight());
+  const auto magenta = [](const test::Image& img) {
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) n += img.at(x, y)[0] > 200 && img.at(x, y)[1] < 60 && img.at(x, y)[2] > 200;
+    return n;
+  };
+  int counts[2] = {0, 0};
+  for (int with = 0; with < 2; ++with) {
+    const auto frames = dir.path() / (with ? "with" : "without");
+    const auto r = run_terravol("fly " + path.string() + " -o " + frames.string() + "/ --fps 10 --end 0.1 --size 320x180" +
+                                (with ? " --object " + box.string() + "@45.108,6.312,800" : ""));
+    ASSERT_EQ(r.status, 0) << r.err;
+    counts[with] = magenta(test::read_png(frames / "frame_000000.png"));
+  }
+  EXPECT_EQ(counts[0], 0);
+  EXPECT_GT(counts[1], 1000);  // about 90 x 80 pixels of the 320 x 180
+  expect_rejected(dir, flight().dump(), "--object 'x.glb': expected FILE@LAT,LON,AGL", "--object x.glb");
+  expect_rejected(dir, flight().dump(), "missing.glb: no such file", "--object " + (dir.path() / "missing.glb").string() + "@45.1,6.3,0");
+}
+
 TEST(FlyCli, CameraUnderGroundOrFarBeyondTheDemFailsBeforeAnyFrame) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;

@@ -258,6 +258,22 @@ TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   expect_clean_failure(std::string(TERRAVOL_SOURCE_DIR) + "/missing.hgt --camera 45.5,6.5,3000,0,-10", "missing.hgt");
 }
 
+TEST(RenderCli, BadObjectsFailCleanlyWithOneLine) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const std::string view = bundled_dem() + " --camera 45.5,6.5,3000,0,-10 --object ";
+  expect_clean_failure(view + "truck.glb", "--object 'truck.glb': expected FILE@LAT,LON,AGL");
+  expect_clean_failure(view + "truck.glb@45.5,6.5,0,scale=0", "scale");
+  expect_clean_failure(view + std::string(TERRAVOL_SOURCE_DIR) + "/missing.glb@45.5,6.5,0", "missing.glb: no such file");
+  // A file that is no model: the DEM itself.
+  expect_clean_failure(view + bundled_dem() + "@45.5,6.5,0", bundled_dem() + ": ");
+  // A real model off the DEM, and one absurdly large.
+  test::TempDir dir;
+  const auto box = dir.path() / "box.obj";
+  std::ofstream(box) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  expect_clean_failure(view + box.string() + "@47.5,6.5,0", box.string() + ": placed at 47.50000, 6.50000, outside the DEM");
+  expect_clean_failure(view + box.string() + "@45.5,6.5,0,scale=100000", box.string() + ": 141 km across at scale 100000");
+}
+
 TEST(RenderCli, CameraBelowTheGroundOrBadLevelsFailCleanly) {
   TERRAVOL_REQUIRE_DISPLAY();
   const std::string dem = bundled_dem();

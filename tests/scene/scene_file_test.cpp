@@ -80,7 +80,7 @@ TEST(SceneFile, RenderStyleKeysAreRead) {
 
 TEST(SceneFile, ErrorsNameTheFileAndTheKeyPath) {
   EXPECT_EQ(error_of(R"({"dem": [], "volumez": []})"),
-            "scene.json: volumez: unknown key (known: dem, volumes, camera, render)");
+            "scene.json: volumez: unknown key (known: dem, volumes, objects, camera, render)");
   EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "slices": [{"agl": 300}, {"agl": 1, "lat": 2}]}]})"),
             "scene.json: volumes[0].slices[1]: needs exactly one of lat, lon, alt, agl");
   EXPECT_EQ(error_of(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 1, "opacity": 2}]}]})"),
@@ -114,6 +114,77 @@ TEST(SceneFile, FilesThatAreNotScenesFailWithOneLine) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("missing.json: cannot read"), std::string::npos) << e.what();
   }
+}
+
+TEST(SceneFile, ObjectsAreReadWithTheirPoses) {
+  const SceneSpec s = parse_scene_json(
+      json::parse(R"({"objects": [{"file": "truck.glb", "lat": 44.27, "lon": -71.3, "heading": 45, "pitch": 5,
+                                     "roll": -3, "scale": 10, "opacity": 0.5, "up": "z"},
+                                    {"file": "/m/mast.obj", "lat": 44.3, "lon": -71.2, "height": 900}]})"),
+      "/base", "scene.json");
+  ASSERT_EQ(s.objects.size(), 2u);
+  const ObjectSpec& a = s.objects[0];
+  EXPECT_EQ(a.file, std::filesystem::path("/base/truck.glb"));
+  EXPECT_EQ(a.pose.lat, 44.27);
+  EXPECT_EQ(a.pose.lon, -71.3);
+  EXPECT_TRUE(a.agl);
+  EXPECT_EQ(a.pose.height, 0.0);
+  EXPECT_EQ(a.pose.heading_deg, 45.0);
+  EXPECT_EQ(a.pose.pitch_deg, 5.0);
+  EXPECT_EQ(a.pose.roll_deg, -3.0);
+  EXPECT_EQ(a.pose.scale, 10.0);
+  EXPECT_EQ(a.opacity, 0.5);
+  EXPECT_EQ(a.pose.up, objects::UpAxis::kZ);
+  const ObjectSpec& b = s.objects[1];
+  EXPECT_EQ(b.file, std::filesystem::path("/m/mast.obj"));
+  EXPECT_FALSE(b.agl);
+  EXPECT_EQ(b.pose.height, 900.0);
+  EXPECT_EQ(b.pose.up, objects::UpAxis::kY);
+}
+
+TEST(SceneFile, BadObjectsNameTheKey) {
+  EXPECT_EQ(error_of(R"({"objects": [{"lat": 1, "lon": 2}]})"), "scene.json: objects[0]: missing \"file\"");
+  EXPECT_EQ(error_of(R"({"objects": [{"file": "a.glb", "lat": 1, "lon": 2, "agl": 1, "height": 2}]})"),
+            "scene.json: objects[0]: give height (above the datum) or agl (above the ground), not both");
+  EXPECT_EQ(error_of(R"({"objects": [{"file": "a.glb", "lat": 1, "lon": 2, "scale": 0}]})"),
+            "scene.json: objects[0].scale: must be > 0");
+  EXPECT_EQ(error_of(R"({"objects": [{"file": "a.glb", "lat": 1, "lon": 2, "up": "x"}]})"),
+            "scene.json: objects[0].up: expected \"y\" or \"z\", got \"x\"");
+  EXPECT_EQ(error_of(R"({"objects": [{"file": "a.glb", "lat": 100, "lon": 2}]})"),
+            "scene.json: objects[0].lat: must be within [-85, 85], is 100");
+  EXPECT_EQ(error_of(R"({"objects": {"file": "a.glb"}})"), "scene.json: objects: expected a list");
+}
+
+TEST(ObjectOption, ParsesFileAtLatLonAglAndKeys) {
+  const ObjectSpec o = parse_object("models/truck.gltf@44.27,-71.30,2.5,heading=45,scale=10,up=z");
+  EXPECT_EQ(o.file, std::filesystem::path("models/truck.gltf"));
+  EXPECT_EQ(o.pose.lat, 44.27);
+  EXPECT_EQ(o.pose.lon, -71.30);
+  EXPECT_TRUE(o.agl);
+  EXPECT_EQ(o.pose.height, 2.5);
+  EXPECT_EQ(o.pose.heading_deg, 45.0);
+  EXPECT_EQ(o.pose.scale, 10.0);
+  EXPECT_EQ(o.pose.up, objects::UpAxis::kZ);
+  EXPECT_EQ(parse_object("a@b.obj@1,2,3").file, std::filesystem::path("a@b.obj"));  // the last '@' splits
+}
+
+TEST(ObjectOption, BadTextIsOneLineNamingTheOption) {
+  const auto error = [](const std::string& text) {
+    try {
+      parse_object(text);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("truck.glb"), "--object 'truck.glb': expected FILE@LAT,LON,AGL[,heading=..][,scale=..]");
+  EXPECT_EQ(error("truck.glb@1,2"), "--object 'truck.glb@1,2': expected LAT,LON,AGL after '@'");
+  EXPECT_EQ(error("truck.glb@1,x,2"), "--object 'truck.glb@1,x,2': 'x' is not a number");
+  EXPECT_EQ(error("truck.glb@1,2,3,size=4"),
+            "--object 'truck.glb@1,2,3,size=4': unknown key 'size' (known: heading, pitch, roll, scale, opacity, up)");
+  EXPECT_EQ(error("truck.glb@1,2,3,scale=-1"), "--object 'truck.glb@1,2,3,scale=-1': scale: must be within [0, 1e+06], is -1");
+  EXPECT_EQ(error("truck.glb@1,2,3,heading"), "--object 'truck.glb@1,2,3,heading': 'heading' is not KEY=VALUE");
+  EXPECT_EQ(error("truck.glb@1,2,3,scale=2,scale=3"), "--object 'truck.glb@1,2,3,scale=2,scale=3': 'scale' given twice");
 }
 
 }  // namespace

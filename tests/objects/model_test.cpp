@@ -1,0 +1,185 @@
+#include "objects/model.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <glm/common.hpp>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "io/error.h"
+#include "objects/test_models.h"
+#include "temp_dir.h"
+
+namespace terravol::objects {
+namespace {
+
+std::vector<char> bytes_of(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+std::string error_of(const std::filesystem::path& p) {
+  try {
+    read_model(p);
+  } catch (const io::FormatError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// A binary STL read by hand: 80 header bytes, a uint32 count, 50 bytes per triangle (normal,
+// three vertices, attribute).
+std::vector<std::array<glm::vec3, 3>> stl_triangles(const std::vector<char>& b) {
+  std::uint32_t n = 0;
+  std::memcpy(&n, b.data() + 80, 4);
+  std::vector<std::array<glm::vec3, 3>> out(n);
+  for (std::uint32_t t = 0; t < n; ++t) {
+    for (int v = 0; v < 3; ++v) std::memcpy(&out[t][static_cast<std::size_t>(v)], b.data() + 84 + 50 * t + 12 + 12 * v, 12);
+  }
+  return out;
+}
+
+TEST(Model, BinaryStlGivesTheFilesTrianglesInOrder) {
+  REQUIRE_ASSIMP_MODEL("STL/Spider_binary.stl");
+  const auto file = test::assimp_model("STL/Spider_binary.stl");
+  const Model m = read_model(file);
+  std::vector<std::array<glm::vec3, 3>> expected;
+  for (const auto& t : stl_triangles(bytes_of(file))) {
+    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) expected.push_back(t);
+  }
+  ASSERT_EQ(m.mesh.triangle_count(), expected.size());
+  for (std::size_t t = 0; t < expected.size(); ++t) {
+    for (std::size_t v = 0; v < 3; ++v) {
+      const glm::dvec3 got = m.mesh.vertices[m.mesh.triangles[3 * t + v]];
+      ASSERT_EQ(glm::vec3(got), expected[t][v]) << "triangle " << t << " vertex " << v;
+    }
+  }
+  EXPECT_LT(m.mesh.vertices.size(), 3 * expected.size()) << "shared vertices are joined";
+}
+
+TEST(Model, PlyQuadsBecomeTwoTrianglesEach) {
+  REQUIRE_ASSIMP_MODEL("PLY/cube.ply");
+  const Model m = read_model(test::assimp_model("PLY/cube.ply"));
+  EXPECT_EQ(m.mesh.triangle_count(), 12u);  // six quad faces in the file
+  glm::dvec3 lo(1e9), hi(-1e9);
+  for (const auto& v : m.mesh.vertices) {
+    lo = glm::min(lo, v);
+    hi = glm::max(hi, v);
+  }
+  EXPECT_EQ(lo, glm::dvec3(0.0));
+  EXPECT_EQ(hi, glm::dvec3(1.0));
+}
+
+TEST(Model, PerVertexColoursAreTheFiles) {
+  REQUIRE_ASSIMP_MODEL("PLY/float-color.ply");
+  const Model m = read_model(test::assimp_model("PLY/float-color.ply"));
+  ASSERT_EQ(m.mesh.triangle_count(), 1u);
+  EXPECT_TRUE(m.vertex_colors);
+  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 0, 255, 255));  // "0 0 1 1" per vertex
+}
+
+// The truck's triangles counted from its glTF file: each node's meshes' primitives' index
+// counts over three, every node of the default scene's hierarchy counted.
+std::size_t gltf_triangles(const nlohmann::json& d, const std::string& node) {
+  std::size_t n = 0;
+  const auto& nd = d["nodes"][node];
+  if (nd.contains("meshes")) {
+    for (const auto& mesh : nd["meshes"]) {
+      for (const auto& p : d["meshes"][mesh.get<std::string>()]["primitives"]) {
+        n += d["accessors"][p["indices"].get<std::string>()]["count"].get<std::size_t>() / 3;
+      }
+    }
+  }
+  for (const auto& c : nd["children"]) n += gltf_triangles(d, c.get<std::string>());
+  return n;
+}
+
+TEST(Model, GltfMilkTruckHasEveryNodesTrianglesAndMaterialColours) {
+  REQUIRE_ASSIMP_MODEL("glTF/CesiumMilkTruck/CesiumMilkTruck.gltf");
+  const auto file = test::assimp_model("glTF/CesiumMilkTruck/CesiumMilkTruck.gltf");
+  const nlohmann::json d = nlohmann::json::parse(std::ifstream(file));
+  std::size_t expected = 0;
+  for (const auto& n : d["scenes"][d["scene"].get<std::string>()]["nodes"]) expected += gltf_triangles(d, n.get<std::string>());
+  const Model m = read_model(file);
+  EXPECT_EQ(m.mesh.triangle_count(), expected);
+  EXPECT_EQ(m.meshes, 5u);  // truck, glass, window trim, and the wheels mesh used by two nodes
+  // The window trim's diffuse colour [0.064, 0.064, 0.064] is 16/255 on some vertices.
+  bool trim = false;
+  for (const auto& c : m.mesh.colors) trim = trim || c == glm::u8vec4(16, 16, 16, 255);
+  EXPECT_TRUE(trim);
+}
+
+TEST(Model, ObjMaterialColourAndOpacity) {
+  test::TempDir dir;
+  write(dir.path() / "m.mtl", "newmtl red\nKd 1 0 0\nd 0.5\n");
+  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl red\nf 1 2 3 4\n");
+  const Model m = read_model(dir.path() / "m.obj");
+  ASSERT_EQ(m.mesh.triangle_count(), 2u);
+  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(255, 0, 0, 128));
+}
+
+TEST(Model, BadInputIsOneLineNamingTheFile) {
+  test::TempDir dir;
+  const auto expect_error = [](const std::filesystem::path& p, const std::string& part) {
+    const std::string e = error_of(p);
+    EXPECT_EQ(e.rfind(p.string() + ": ", 0), 0u) << e;
+    EXPECT_NE(e.find(part), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  };
+  expect_error(dir.path() / "absent.glb", "no such file");
+  write(dir.path() / "empty.obj", "");
+  expect_error(dir.path() / "empty.obj", "empty file");
+  write(dir.path() / "junk.stl", std::string("solid x\nthis is not an stl file at all\n"));
+  expect_error(dir.path() / "junk.stl", "");
+  write(dir.path() / "junk.gltf", "{ \"asset\": ");
+  expect_error(dir.path() / "junk.gltf", "");
+  write(dir.path() / "junk.xyzzy", "nothing assimp knows");
+  expect_error(dir.path() / "junk.xyzzy", "");
+  write(dir.path() / "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n");
+  expect_error(dir.path() / "lines.obj", "no triangles");
+  expect_error(dir.path(), "not a regular file");
+  if (std::filesystem::exists(test::assimp_model("PLY/points.ply"))) {
+    expect_error(test::assimp_model("PLY/points.ply"), "no triangles");
+  }
+  if (std::filesystem::exists(test::assimp_model("PLY/pond.0.ply"))) {
+    expect_error(test::assimp_model("PLY/pond.0.ply"), "no triangles");  // a coloured point cloud
+  }
+}
+
+TEST(Model, TruncatedBinaryStlIsRefusedAtEveryLength) {
+  REQUIRE_ASSIMP_MODEL("STL/Spider_binary.stl");
+  const std::vector<char> b = bytes_of(test::assimp_model("STL/Spider_binary.stl"));
+  test::TempDir dir;
+  const auto p = dir.path() / "cut.stl";
+  for (std::size_t n : {std::size_t{1}, std::size_t{80}, std::size_t{84}, std::size_t{100}, b.size() / 2, b.size() - 1}) {
+    std::ofstream(p, std::ios::binary).write(b.data(), static_cast<std::streamsize>(n));
+    const std::string e = error_of(p);
+    EXPECT_EQ(e.rfind(p.string() + ": ", 0), 0u) << n << " bytes: " << e;
+  }
+}
+
+TEST(Model, AbsurdlyLargeModelIsRefused) {
+  // A binary STL claiming kMaxModelTriangles + 1 triangles, with the bytes to hold them.
+  test::TempDir dir;
+  const auto p = dir.path() / "huge.stl";
+  const std::uint32_t n = static_cast<std::uint32_t>(kMaxModelTriangles + 1);
+  std::vector<char> b(84 + 50 * static_cast<std::size_t>(n), 0);
+  std::memcpy(b.data() + 80, &n, 4);
+  for (std::uint32_t t = 0; t < n; ++t) {
+    const float v[9] = {static_cast<float>(t), 0, 0, static_cast<float>(t) + 1, 0, 0, static_cast<float>(t), 1, 0};
+    std::memcpy(b.data() + 84 + 50 * static_cast<std::size_t>(t) + 12, v, sizeof v);
+  }
+  std::ofstream(p, std::ios::binary).write(b.data(), static_cast<std::streamsize>(b.size()));
+  EXPECT_NE(error_of(p).find("too large"), std::string::npos) << error_of(p);
+}
+
+}  // namespace
+}  // namespace terravol::objects
