@@ -1102,9 +1102,14 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   m.merge_stats.lazy_build_ms = 0.0;
   // Replacing every surface there is, or the first with texture coordinates coming or the last
   // going: start from nothing (no old polygons to remove).
+  // The given ids sorted, so that each stored surface is looked up in O(log k): with thousands
+  // of object instances a linear search per surface would be quadratic.
+  std::vector<std::uint32_t> sorted_ids(ids.begin(), ids.end());
+  std::sort(sorted_ids.begin(), sorted_ids.end());
+  const auto given = [&](std::uint32_t id) { return std::binary_search(sorted_ids.begin(), sorted_ids.end(), id); };
   bool everything = true, tcoords = false;
   for (const auto& [id, s] : m.surfaces) {
-    const bool replaced = std::find(ids.begin(), ids.end(), id) != ids.end();
+    const bool replaced = given(id);
     everything = everything && replaced;
     tcoords = tcoords || (!replaced && !s.tcoords.empty());
   }
@@ -1146,7 +1151,7 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   std::vector<std::size_t> changed;  // indices into m.surfaces to distribute
   std::vector<std::uint32_t> changed_ids(ids.begin(), ids.end());
   for (std::size_t k = 0; k < m.surfaces.size(); ++k) {
-    if (flip || std::find(ids.begin(), ids.end(), m.surfaces[k].first) != ids.end()) changed.push_back(k);
+    if (flip || given(m.surfaces[k].first)) changed.push_back(k);
     if (flip) changed_ids.push_back(m.surfaces[k].first);
   }
   tbb::parallel_for(std::size_t{0}, changed.size(), [&](std::size_t k) { m.distribute(m.surfaces[changed[k]].second); });
