@@ -185,6 +185,7 @@ json lowalt_suite(const BenchConfig& c, const Terrain& terrain) {
   std::vector<View> views = low_views(place, std::max(1, low_count));
   for (const View& v : high_views(scene.terrain().bounds(), high_count)) views.push_back(v);
   ItemBuffer items(scene);
+  mrbsp::Frame forced;
 
   // Per view and threshold: occlusion off, then on, one after the other.
   struct Side {
@@ -194,7 +195,7 @@ json lowalt_suite(const BenchConfig& c, const Terrain& terrain) {
     double t = 1.0;
     bool high = false;
     Side off, on;
-    std::vector<double> ratio, identical, pass_ms, probe_ms, ran, tested, culled_nodes, culled_triangles, extra_triangles;
+    std::vector<double> ratio, identical, forced_identical, forced_triangles, pass_ms, probe_ms, ran, tested, culled_nodes, culled_triangles, extra_triangles;
     std::vector<double> hidden, hidden_share, hidden_culled_share, visible_culled, crack_pixel_share, crack_triangle_share;
   };
   std::vector<Config> configs;
@@ -250,9 +251,19 @@ json lowalt_suite(const BenchConfig& c, const Terrain& terrain) {
       k.tested.push_back(static_cast<double>(on.occlusion.tested_nodes));
       k.culled_nodes.push_back(static_cast<double>(on.occlusion.culled_nodes));
 
+      // What the pass culls when it runs: the same view traversed again with the pass in every
+      // traversal (occlusion_adaptive off), drawn and compared too.
+      mrbsp::TraversalOptions forced_options = lod(mrbsp::LodMetric::kError, k.t);
+      forced_options.occlusion = true;
+      forced_options.occlusion_adaptive = false;
+      scene.terrain().tree().traverse(scene.camera(), forced_options, forced);
+      scene.renderer().set_frame(forced);
+      scene.renderer().render();
+      k.forced_identical.push_back(scene.renderer().rgb() == image_off ? 1.0 : 0.0);
+      k.forced_triangles.push_back(static_cast<double>(forced.indices.size() / 3));
       // Hidden: the off frame's triangles that show in no pixel of its item buffer. Culled: the
-      // off frame's triangles the on frame leaves out.
-      const auto on_set = triangle_set(on);
+      // off frame's triangles the forced pass leaves out.
+      const auto on_set = triangle_set(forced);
       const auto off_set = triangle_set(off);
       double extra = 0;
       for (const TriangleKey& t : on_set) extra += off_set.count(t) ? 0 : 1;
@@ -319,6 +330,9 @@ json lowalt_suite(const BenchConfig& c, const Terrain& terrain) {
     j["tested_nodes"] = to_json(summarize(k.tested));
     j["culled_nodes"] = to_json(summarize(k.culled_nodes));
     j["culled_triangles"] = to_json(summarize(k.culled_triangles));
+    j["forced_pass"] = {{"triangles", to_json(summarize(k.forced_triangles))},
+                        {"images_identical", std::accumulate(k.forced_identical.begin(), k.forced_identical.end(), 0.0) /
+                                                 static_cast<double>(k.forced_identical.size())}};
     j["triangles_on_not_off"] = *std::max_element(k.extra_triangles.begin(), k.extra_triangles.end());
     j["hidden_triangles"] = to_json(summarize(k.hidden));
     j["hidden_share_of_drawn"] = to_json(summarize(k.hidden_share));

@@ -98,8 +98,10 @@ nlohmann::json rf_suite(const BenchConfig& config, const std::filesystem::path& 
 // view, at 1 and 2 px, occlusion culling off then on: frame, traversal and draw times,
 // triangles, whether the images are identical, the pass's time and tests; and from an item
 // buffer of the off frame (bench/item_buffer.h): the triangles drawn that show in no pixel
-// (hidden), the share of them the occlusion pass culled, visible triangles culled (0 when
-// conservative), and the crack fills' share of the terrain's pixels. Then a low flight of
+// (hidden), the share of them the occlusion pass culls when it runs (a traversal with
+// occlusion_adaptive off, whose image is compared too), visible triangles culled (0 when
+// conservative), and the crack fills' share of the terrain's pixels; with the share of timed
+// frames the pass ran in and its time in the warm-up (the probe). Then a low flight of
 // `flight_frames` frames (100 to 500 m above the ground, along a valley): per frame the unculled
 // draw, and occlusion at 1 px testing every node, with hierarchy updating and with conservative
 // updating (p_skip 0.5), each from its own Frame: node tests, skipped tests, pass time, and

@@ -625,8 +625,34 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const auto tile = [&](const Projected& a, const Projected& b, const Projected& c) {
       if (!a.ok || !b.ok || !c.ok) return;
       const glm::dvec2 w[3] = {a.w, b.w, c.w};
-      pyramid.cover(w, error_px(std::max({a.extent, b.extent, c.extent}), std::min({a.depth, b.depth, c.depth})));
       ++frame.occlusion.tiled_triangles;
+      pyramid.cover(w, error_px(std::max({a.extent, b.extent, c.extent}), std::min({a.depth, b.depth, c.depth})));
+    };
+    // A cell's two terrain triangles, (sw, se, ne) and (sw, ne, nw): when both project with
+    // the same orientation, se and nw lie on opposite sides of their shared diagonal, so
+    // together they are the quadrilateral (sw, se, ne, nw), tiled in one call (the pyramid
+    // claims no more than the quadrilateral's inside even when it is not convex). The
+    // quadrilateral also claims the centres near the diagonal, which the triangles tiled
+    // apart would leave to neither: they share its two transformed vertices, and GL's
+    // rasterization is watertight, so every centre on or near it is filled by one of them.
+    const auto tile_cell = [&](const Projected& sw, const Projected& se, const Projected& ne, const Projected& nw) {
+      const auto area2 = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+      };
+      // Twice the signed areas, px^2; nearly flat triangles (whose orientation the float
+      // pipeline may see otherwise) are tiled apart.
+      constexpr double kMinArea2 = 1e-3;
+      const bool ok = sw.ok && se.ok && ne.ok && nw.ok;
+      const double s0 = ok ? area2(sw.w, se.w, ne.w) : 0.0, s1 = ok ? area2(sw.w, ne.w, nw.w) : 0.0;
+      if (!((s0 > kMinArea2 && s1 > kMinArea2) || (s0 < -kMinArea2 && s1 < -kMinArea2))) {
+        tile(sw, se, ne);
+        tile(sw, ne, nw);
+        return;
+      }
+      const glm::dvec2 w[4] = {sw.w, se.w, ne.w, nw.w};
+      frame.occlusion.tiled_triangles += 2;
+      pyramid.cover(w, error_px(std::max({sw.extent, se.extent, ne.extent, nw.extent}),
+                                std::min({sw.depth, se.depth, ne.depth, nw.depth})));
     };
     glm::dvec2 corners[8];
     walk(
@@ -714,8 +740,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
           const Projected sw = project_vertex(m.vertex(i0, j0)), se = project_vertex(m.vertex(i0 + s, j0)),
                           ne = project_vertex(m.vertex(i0 + s, j0 + s)), nw = project_vertex(m.vertex(i0, j0 + s));
-          tile(sw, se, ne);
-          tile(sw, ne, nw);
+          tile_cell(sw, se, ne, nw);
           std::array<Edge, 4> edges;
           edges_of(level, ci, cj, edges);
           // Each fill's ends are two of the cell's corners, in the order edges_of gives them.
