@@ -97,15 +97,21 @@ TEST(Occlusion, LeavesOutOnlyTerrainHiddenBehindWhatItDrawsAndKeepsTheOrder) {
   EXPECT_GT(culled_total, 50u) << "the ridges must hide cells for the test to mean anything";
 }
 
-TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
-  const TestWindow w = ridged();
-  const TerrainTree tree(w.view(), 5);
+// Straight down from 20 km over the ridged window's centre: nothing is hidden.
+Camera from_above() {
   Camera c;
   c.eye = {3200.0, 3200.0, 20000.0};
   c.forward = {0.0, 0.0, -1.0};
   c.up = {0.0, 1.0, 0.0};
   c.width = 400;
   c.height = 240;
+  return c;
+}
+
+TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
+  const TestWindow w = ridged();
+  const TerrainTree tree(w.view(), 5);
+  const Camera c = from_above();
   TraversalOptions o;
   o.occlusion = true;
   Frame f;
@@ -121,12 +127,7 @@ TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
 TEST(Occlusion, APassThatDoesNotPayIsLeftOutOfTheNextEightFramesThenTriedAgain) {
   const TestWindow w = ridged();
   const TerrainTree tree(w.view(), 5);
-  Camera above;
-  above.eye = {3200.0, 3200.0, 20000.0};
-  above.forward = {0.0, 0.0, -1.0};
-  above.up = {0.0, 1.0, 0.0};
-  above.width = 400;
-  above.height = 240;
+  const Camera above = from_above();
   TraversalOptions o;
   Frame unculled, f;
   tree.traverse(above, o, unculled);
