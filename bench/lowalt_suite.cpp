@@ -217,7 +217,7 @@ json lowalt_suite(const BenchConfig& c, const Terrain& terrain) {
         mrbsp::TraversalOptions o = lod(mrbsp::LodMetric::kError, k.t);
         o.occlusion = occlusion;
         scene.render(pose, true, 45.0, o);  // warm-up (and the view's slide, if any)
-        if (occlusion) k.probe_ms.push_back(scene.last_frame().occlusion.pass_ms);
+        if (occlusion && scene.last_frame().occlusion.ran) k.probe_ms.push_back(scene.last_frame().occlusion.pass_ms);
         const int slides = scene.slides();
         std::vector<double> fr, tr, dr;
         app::render::FrameStats s;

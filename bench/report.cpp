@@ -283,7 +283,7 @@ void lowalt_section(std::ostringstream& md, const json& results) {
         "drawn in a colour of its own, in the frame's order); hidden culled: the share of those the "
         "occlusion pass left out when it runs (the view traversed again with the pass forced: "
         "occlusion_adaptive leaves a pass that does not pay out of the next 8 frames; pass ran: the share of "
-        "timed frames it ran in, probe: its time in the warm-up frame). Crack pixels: the terrain pixels whose front triangle is a crack fill. "
+        "timed frames it ran in, probe: its time in the warm-up frames it ran in). Crack pixels: the terrain pixels whose front triangle is a crack fill. "
         "Medians over the views (10th-90th percentile in brackets).\n\n";
   for (const json& t : results["lowalt"]) {
     md << "### " << t["terrain"].get<std::string>() << " (" << t["low_views"].get<int>() << " low views, "
