@@ -565,7 +565,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // LOD cell's box (its content's) tested against the coverage of the opaque terrain tiled
   // so far (section 5.2, test-only tiling of the box's silhouette), and each drawn cell's
   // terrain triangles and crack fills tiled (section 3.1). Merged polygons are translucent and
-  // never tiled. Everything tiled before a cell lies on the near side of some plane that
+  // never tiled; walls are not tiled either (less coverage is always conservative). Everything tiled before a cell lies on the near side of some plane that
   // separates it from the cell, so a cell whose box is covered is hidden by nearer opaque
   // terrain, which the back-to-front draw puts over it: leaving it out changes no pixel.
   // Window coordinates are computed in double precision as GL maps them (glViewport(0, 0,
