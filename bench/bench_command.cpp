@@ -33,8 +33,8 @@ struct BenchOptions {
   std::vector<std::filesystem::path> dems;
   std::filesystem::path under_test;
   std::string exactness_views;
-  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects";
-  int views = 0, repeats = 0;
+  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects,lowalt";
+  int views = 0, repeats = 0, frames = 0;
 };
 
 // The first line of `file` that starts with `key`, after the colon; empty when absent.
@@ -85,13 +85,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects", "lowalt"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build, exactness, rf, objects)");
+                               "' (terrain, translucency, scaling, build, exactness, rf, objects, lowalt)");
     }
     out.insert(s);
   }
@@ -108,6 +108,7 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   c.repeats = o.quick ? 2 : 3;
   c.plain_largest = !o.quick;
   c.quick = o.quick;
+  c.flight_frames = o.frames ? o.frames : o.quick ? 100 : 1000;
   c.out = o.out;
   c.under_test = o.under_test;
   c.exactness_views = o.exactness_views;
@@ -172,6 +173,8 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     for (const Terrain& t : real) results["build"].push_back(build_suite(c, t));
   if (suites.count("terrain"))
     for (const Terrain& t : real) results["terrain"].push_back(terrain_suite(c, t));
+  if (suites.count("lowalt"))
+    for (const Terrain& t : real) results["lowalt"].push_back(lowalt_suite(c, t));
   if (suites.count("translucency"))
     for (std::size_t k = 0; k < transmitters.size(); ++k)
       results["translucency"].push_back(translucency_suite(c, real[k], transmitters[k]));
@@ -237,17 +240,19 @@ void run_bench(const BenchOptions& o, const std::string& command) {
 void add_bench_command(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   auto* cmd = app.add_subcommand("bench", "Run the standing benchmarks and write a JSON and Markdown report with plots");
-  cmd->add_flag("--quick", o->quick, "A few minutes: 12 views, 3 orbit views, 2 repetitions, no plain VTK on the largest terrain");
+  cmd->add_flag("--quick", o->quick, "A few minutes: 12 views, 3 orbit views, 2 repetitions, a 100-frame low flight, no plain VTK on the largest terrain");
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects, lowalt")->capture_default_str();
   cmd->add_option("--under-test", o->under_test,
                   "The terravol executable whose render the exactness suite measures (default: this one)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--exactness-views", o->exactness_views,
                   "Exactness: only these views, comma-separated VIEW or TERRAIN-VIEW (e.g. n44w072-inside)");
   cmd->add_option("--views", o->views, "Views of each terrain flythrough (default 60, quick 12)")->check(CLI::Range(1, 10000));
+  cmd->add_option("--frames", o->frames, "Frames of the low-altitude suite's flight (default 1000, quick 100)")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--repeats", o->repeats, "Timed repetitions per frame (default 3, quick 2)")->check(CLI::Range(1, 100));
   cmd->callback([o] {
     std::string command = "terravol bench";  // as given, for the report
@@ -255,6 +260,7 @@ void add_bench_command(CLI::App& app) {
     if (o->suites != BenchOptions{}.suites) command += " --suites " + o->suites;
     if (o->views) command += " --views " + std::to_string(o->views);
     if (o->repeats) command += " --repeats " + std::to_string(o->repeats);
+    if (o->frames) command += " --frames " + std::to_string(o->frames);
     for (const auto& d : o->dems) command += " --dem " + d.string();
     if (!o->under_test.empty()) command += " --under-test " + o->under_test.string();
     if (!o->exactness_views.empty()) command += " --exactness-views " + o->exactness_views;

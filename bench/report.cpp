@@ -308,6 +308,48 @@ void objects_section(std::ostringstream& md, const json& results) {
   md << "\n";
 }
 
+void lowalt_section(std::ostringstream& md, const json& results) {
+  if (!results.contains("lowalt")) return;
+  md << "## 10. Low altitude: occlusion culling and coherence\n\n"
+     << "Low views 100-500 m above the ground in valleys and toward ridges, and high views (3000-8000 m) for "
+        "the culling's overhead; per view the same LOD choice drawn with coverage-mask occlusion culling off, "
+        "then on. Hidden: triangles of the off frame that show in no pixel of its item buffer (each triangle "
+        "drawn in a colour of its own, in the frame's order); hidden culled: the share of those the "
+        "occlusion pass left out when it runs (the view traversed again with the pass forced: "
+        "occlusion_adaptive leaves a pass that does not pay out of the next 8 frames; pass ran: the share of "
+        "timed frames it ran in, probe: its time in the warm-up frames it ran in). Crack pixels: the terrain pixels whose front triangle is a crack fill. "
+        "Medians over the views (10th-90th percentile in brackets).\n\n";
+  for (const json& t : results["lowalt"]) {
+    md << "### " << t["terrain"].get<std::string>() << " (" << t["low_views"].get<int>() << " low views, "
+       << t["high_views"].get<int>() << " high)\n\n"
+       << "| views | px | frame ms off | frame ms on | off / on (per view) | off / on (medians) | images identical | "
+          "pass ran | pass ms (probe) | triangles off | triangles on | hidden of drawn | hidden culled | visible culled | crack pixels |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const json& k : t["occlusion"]) {
+      md << "| " << k["views"].get<std::string>() << " | " << num(k["threshold_px"].get<double>()) << " | "
+         << spread(k["off"]["frame_ms"]) << " | " << spread(k["on"]["frame_ms"]) << " | " << spread(k["off_over_on"])
+         << " | " << num(k["off_over_on_of_medians"].get<double>()) << " | " << pct(k["images_identical"].get<double>())
+         << " | " << pct(k["pass_ran_share"].get<double>()) << " | " << spread(k["probe_pass_ms"]) << " | "
+         << num(med(k["off"]["triangles"]), "%.0f") << " | "
+         << num(med(k["on"]["triangles"]), "%.0f") << " | " << pct(med(k["hidden_share_of_drawn"])) << " | "
+         << pct(med(k["hidden_culled_share"])) << " | " << num(k["visible_culled"].get<double>(), "%.0f") << " | "
+         << pct(med(k["crack_pixel_share"])) << " |\n";
+    }
+    const json& f = t["flight"];
+    md << "\nA " << f["frames"].get<int>() << "-frame low flight at 1 px (unculled frame "
+       << spread(f["off_frame_ms"]) << " ms): occlusion node tests per frame\n\n"
+       << "| coherence | queries per frame (tests and samples) | skipped per frame | queries / testing every node | pass ms | images identical |\n"
+       << "|---|---|---|---|---|---|\n";
+    for (const char* name : {"every_node", "update", "conservative"}) {
+      const json& m = f[name];
+      md << "| " << name << " | " << spread(m["visibility_queries"], "%.0f") << " | " << spread(m["skipped_tests"], "%.0f")
+         << " | " << pct(m["tests_over_every_node"].get<double>()) << " | " << spread(m["pass_ms"]) << " | "
+         << pct(m["images_identical"].get<double>()) << " |\n";
+    }
+    md << "\n";
+  }
+}
+
 }  // namespace
 
 std::string headline(const json& results) {
@@ -347,6 +389,17 @@ std::string headline(const json& results) {
           h << ", " << v["view"].get<std::string>() << " " << num(100.0 * v["within_8"].get<double>(), "%.3f") << "%";
       h << "; bsp against its own peel within 3/255, lowest view "
         << num(100.0 * t["min_bsp_vs_peel_within_3"].get<double>(), "%.3f") << "%\n";
+    }
+  if (results.contains("lowalt"))
+    for (const json& t : results["lowalt"]) {
+      const json& low = t["occlusion"][0];
+      const json& high = t["occlusion"][2];
+      h << "low altitude " << t["terrain"].get<std::string>() << " at 1 px: occlusion off / on "
+        << num(med(low["off_over_on"]), "%.2f") << "x (high views " << num(med(high["off_over_on"]), "%.2f")
+        << "x), hidden culled " << pct(med(low["hidden_culled_share"])) << ", images identical "
+        << pct(low["images_identical"].get<double>()) << "; flight tests / every node: update "
+        << pct(t["flight"]["update"]["tests_over_every_node"].get<double>()) << ", conservative "
+        << pct(t["flight"]["conservative"]["tests_over_every_node"].get<double>()) << "\n";
     }
   if (results.contains("build"))
     for (const json& b : results["build"])
@@ -388,6 +441,7 @@ void write_report(const json& results, const std::filesystem::path& dir) {
   exactness_section(md, results);
   rf_section(md, results);
   objects_section(md, results);
+  lowalt_section(md, results);
   const std::string text = md.str();
   app::output::write_file_atomically(dir / "report.md", std::vector<std::uint8_t>(text.begin(), text.end()), true);
   const std::string j = results.dump(1);

@@ -13,6 +13,7 @@
 #include "app/scene/volume_layer.h"
 #include "bench/image_metrics.h"
 #include "bench/plain_vtk.h"
+#include "bench/suite_common.h"
 #include "bench/stats.h"
 #include "io/mosaic.h"
 #include "volume/splat.h"
@@ -24,53 +25,6 @@ namespace terravol::bench {
 namespace {
 
 using nlohmann::json;
-
-void say(const BenchConfig& c, const std::string& line) {
-  if (c.log) c.log(line);
-}
-
-app::render::RenderSettings plain_settings(const BenchConfig& c) {
-  app::render::RenderSettings s;
-  s.width = c.width;
-  s.height = c.height;
-  s.gradient = false;  // one background colour in every pipeline, so images compare
-  s.haze_distance = 0.0;
-  return s;
-}
-
-// The pipeline's options for a benchmark's scene: no legend, windows of at most `max_window` cells.
-app::render::SceneOptions bench_scene_options(int max_window = 1024) {
-  app::render::SceneOptions o;
-  o.max_window = max_window;
-  o.legend = false;
-  return o;
-}
-
-// The scene of a terrain with its window centred on (lat, lon) (the mosaic's centre when both
-// are NaN) at most `max_window` cells wide.
-app::scene::SceneSpec terrain_spec(const Terrain& t, double lat = std::nan(""), double lon = std::nan("")) {
-  app::scene::SceneSpec spec;
-  spec.dems = t.dems;
-  if (!std::isnan(lat)) {
-    app::scene::SceneCamera cam;
-    cam.pose.lat = lat;
-    cam.pose.lon = lon;
-    cam.pose.alt = 1000;
-    cam.agl = true;
-    spec.camera = cam;
-  }
-  return spec;
-}
-
-// Frame time of the MRBSP: traversal, the upload of its triangle list, and the draw.
-double frame_ms(const app::render::FrameStats& s) { return s.traversal_ms + s.upload_ms + s.draw_ms; }
-
-mrbsp::TraversalOptions lod(mrbsp::LodMetric metric, double t) {
-  mrbsp::TraversalOptions o;
-  o.metric = metric;
-  o.threshold_px = static_cast<float>(metric == mrbsp::LodMetric::kError ? t : 250.0 * t);
-  return o;
-}
 
 // The full-resolution lattice of the scene's window drawn by plain VTK, with a translucent
 // overlay (empty: none).

@@ -20,6 +20,7 @@ struct BenchConfig {
   int views = 60;          // views of each terrain flythrough (suite 1)
   int volume_views = 8;    // views of each translucency orbit (suites 2, 5, 6)
   int repeats = 3;         // timed repetitions of each frame, after one untimed warm-up
+  int flight_frames = 1000;  // frames of the low-altitude suite's flight (suite 9)
   bool plain_largest = true;  // scaling: draw the largest terrain with plain VTK too (33 M triangles)
   bool quick = false;         // exactness: the issue's two fixed cameras only (plus the orbit)
   std::filesystem::path cache;  // RF volumes and generated tiles, kept between runs
@@ -103,5 +104,23 @@ nlohmann::json rf_suite(const BenchConfig& config, const std::filesystem::path& 
 // the chosen levels' own, and each model's levels (triangles, Hausdorff errors).
 nlohmann::json object_suite(const BenchConfig& config, const Terrain& terrain, const std::filesystem::path& truck,
                             const std::filesystem::path& wuson);
+
+// 10. Low altitude (issue 12): low views (100, 250 and 500 m above the ground, pitch 0 to -6) in
+// valleys and toward ridges (Utah: the Salt Lake valley toward the Wasatch and up its canyons;
+// N44W072: the White Mountains' notches; any other terrain: the lowest points of its window's
+// central half looking toward the highest), min(views, 20) of them (quick: 4), and 6 high views
+// (3000-8000 m, pitch -25 to -45; quick: 2), in one 1024-cell window centred on the place. Per
+// view, at 1 and 2 px, occlusion culling off then on: frame, traversal and draw times,
+// triangles, whether the images are identical, the pass's time and tests; and from an item
+// buffer of the off frame (bench/item_buffer.h): the triangles drawn that show in no pixel
+// (hidden), the share of them the occlusion pass culls when it runs (a traversal with
+// occlusion_adaptive off, whose image is compared too), visible triangles culled (0 when
+// conservative), and the crack fills' share of the terrain's pixels; with the share of timed
+// frames the pass ran in and its time in the warm-up (the probe). Then a low flight of
+// `flight_frames` frames (100 to 500 m above the ground, along a valley): per frame the unculled
+// draw, and occlusion at 1 px testing every node, with hierarchy updating and with conservative
+// updating (p_skip 0.5), each from its own Frame: node tests, skipped tests, pass time, and
+// whether each image equals the unculled one. Throws what SceneRenderer throws.
+nlohmann::json lowalt_suite(const BenchConfig& config, const Terrain& terrain);
 
 }  // namespace terravol::bench

@@ -565,14 +565,26 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // LOD cell's box (its content's) tested against the coverage of the opaque terrain tiled
   // so far (section 5.2, test-only tiling of the box's silhouette), and each drawn cell's
   // terrain triangles and crack fills tiled (section 3.1). Merged polygons are translucent and
-  // never tiled. Everything tiled before a cell lies on the near side of some plane that
+  // never tiled; walls are not tiled either (less coverage is always conservative). Everything tiled before a cell lies on the near side of some plane that
   // separates it from the cell, so a cell whose box is covered is hidden by nearer opaque
   // terrain, which the back-to-front draw puts over it: leaving it out changes no pixel.
   // Window coordinates are computed in double precision as GL maps them (glViewport(0, 0,
   // width, height)); llvmpipe transforms float positions with float matrices, so a pixel is
   // claimed only when its centre is inside a triangle by more than that error (the margin),
   // and a box is hidden only when its silhouette dilated by it is covered.
-  if (options.occlusion) {
+  // When the pass does not pay (it culled fewer drawn cells than it kept: it tiles every kept
+  // cell, and on llvmpipe tiling a triangle costs about what drawing a hidden one does), the
+  // next kOcclusionBackoff traversals with this Frame leave it out (options.occlusion_adaptive),
+  // and the one after that tries it again. Leaving it out culls nothing: the same image.
+  constexpr int kOcclusionBackoff = 8;
+  bool occlusion = options.occlusion;
+  if (occlusion && options.occlusion_adaptive && frame.occlusion_backoff_ > 0) {
+    --frame.occlusion_backoff_;
+    occlusion = false;
+    frame.occlusion.left_out = true;
+  }
+  if (occlusion) {
+    frame.occlusion.ran = true;
     const auto t0 = std::chrono::steady_clock::now();
     if (!frame.pyramid_ || frame.pyramid_->width() != camera.width || frame.pyramid_->height() != camera.height) {
       frame.pyramid_ = std::make_unique<coverage::Pyramid>(camera.width, camera.height);
@@ -580,7 +592,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       frame.pyramid_->clear();
     }
     coverage::Pyramid& pyramid = *frame.pyramid_;
-    if (frame.visibility_.size() != 3 * static_cast<std::size_t>(m.total_cells)) frame.visibility_.assign(3 * static_cast<std::size_t>(m.total_cells), 0);
+    if (frame.visibility_.size() != m.total_cells) frame.visibility_.assign(m.total_cells, 0);
     const double hw = 0.5 * camera.width, hh = 0.5 * camera.height;
     const double eye_norm = glm::length(e);
     // Window coordinates of p; false (and nothing) when p is not beyond the near plane.
@@ -597,45 +609,79 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const auto error_px = [&](double extent, double depth) {
       return 0.004 + 8.0 * 5.96e-8 * (extent + eye_norm) * focal_px / depth;
     };
-    const auto tile = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-      glm::dvec2 w[3];
-      double depth[3];
-      double extent = 0.0;
-      for (int k = 0; k < 3; ++k) {
-        const glm::dvec3 p(m.positions[k == 0 ? a : k == 1 ? b : c]);
-        if (!project(p, w[k], depth[k])) return;
-        extent = std::max(extent, glm::length(p));
-      }
-      pyramid.cover(w, error_px(extent, std::min({depth[0], depth[1], depth[2]})));
+    // A vertex projected once for the triangles of a cell that share it.
+    struct Projected {
+      glm::dvec2 w;
+      double depth, extent;
+      bool ok;
+    };
+    const auto project_vertex = [&](std::uint32_t v) {
+      const glm::dvec3 p(m.positions[v]);
+      Projected q{};
+      q.ok = project(p, q.w, q.depth);
+      q.extent = glm::length(p);
+      return q;
+    };
+    const auto tile = [&](const Projected& a, const Projected& b, const Projected& c) {
+      if (!a.ok || !b.ok || !c.ok) return;
+      const glm::dvec2 w[3] = {a.w, b.w, c.w};
       ++frame.occlusion.tiled_triangles;
+      pyramid.cover(w, error_px(std::max({a.extent, b.extent, c.extent}), std::min({a.depth, b.depth, c.depth})));
+    };
+    // A cell's two terrain triangles, (sw, se, ne) and (sw, ne, nw): when both project with
+    // the same orientation, se and nw lie on opposite sides of their shared diagonal, so
+    // together they are the quadrilateral (sw, se, ne, nw), tiled in one call (the pyramid
+    // claims no more than the quadrilateral's inside even when it is not convex). The
+    // quadrilateral also claims the centres near the diagonal, which the triangles tiled
+    // apart would leave to neither: they share its two transformed vertices, and GL's
+    // rasterization is watertight, so every centre on or near it is filled by one of them.
+    const auto tile_cell = [&](const Projected& sw, const Projected& se, const Projected& ne, const Projected& nw) {
+      const auto area2 = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+      };
+      // Twice the signed areas, px^2; nearly flat triangles (whose orientation the float
+      // pipeline may see otherwise) are tiled apart.
+      constexpr double kMinArea2 = 1e-3;
+      const bool ok = sw.ok && se.ok && ne.ok && nw.ok;
+      const double s0 = ok ? area2(sw.w, se.w, ne.w) : 0.0, s1 = ok ? area2(sw.w, ne.w, nw.w) : 0.0;
+      if (!((s0 > kMinArea2 && s1 > kMinArea2) || (s0 < -kMinArea2 && s1 < -kMinArea2))) {
+        tile(sw, se, ne);
+        tile(sw, ne, nw);
+        return;
+      }
+      const glm::dvec2 w[4] = {sw.w, se.w, ne.w, nw.w};
+      frame.occlusion.tiled_triangles += 2;
+      pyramid.cover(w, error_px(std::max({sw.extent, se.extent, ne.extent, nw.extent}),
+                                std::min({sw.depth, se.depth, ne.depth, nw.depth})));
     };
     glm::dvec2 corners[8];
     walk(
         false,
         [&](int level, int ci, int cj, int half) {
           const std::uint32_t cell = m.cell_id(level, ci, cj);
-          const bool leaf = half < 0 && state(cell) == kDrawn;
+          // A square's x halves are not tested: their two squares each are, and a half's box
+          // (the union of theirs) is hidden only when both are, so testing it saved less than
+          // its test cost (two more z ranges and eight more projections per refined square).
+          if (half >= 0) return true;
+          const bool leaf = state(cell) == kDrawn;
           // Bittner and Havran 2001: what this node was last frame decides whether to test it.
-          // Hierarchy updating: a node opened last frame (tested visible, not a leaf) and not a
-          // leaf now goes straight to its children, unless both of those were hidden (the
+          // Hierarchy updating: a square opened last frame (tested visible, not a leaf) and not
+          // a leaf now goes straight to its children, unless all four of those were hidden (the
           // pull-up: it is then a termination node again and tested). Conservative updating:
           // a leaf visible last frame is assumed visible again with probability p_skip
           // (decided by a hash of the cell and the frame, so runs repeat). Either way nothing
           // that would be drawn is left out: the LOD choice and the image do not change.
-          std::uint32_t* memo = &frame.visibility_[3 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(half + 1)];
-          const auto was = [&](const std::uint32_t* v) { return *v >> 2 == frame.current_stamp_ - 1 ? *v & 3u : 0u; };
+          std::uint32_t* memo = &frame.visibility_[cell];
+          const auto was = [&](std::uint32_t v) { return v >> 2 == frame.current_stamp_ - 1 ? v & 3u : 0u; };
           const auto remember = [&](std::uint32_t v) { *memo = frame.current_stamp_ << 2 | v; };
-          // The node's two children: a square's halves, a half's squares.
-          const std::uint32_t* children[2];
-          if (half < 0) {
-            children[0] = &frame.visibility_[3 * static_cast<std::size_t>(cell) + 1];
-            children[1] = &frame.visibility_[3 * static_cast<std::size_t>(cell) + 2];
-          } else {
-            for (int b = 0; b < 2; ++b) children[b] = &frame.visibility_[3 * static_cast<std::size_t>(m.cell_id(level + 1, 2 * ci + half, 2 * cj + b))];
-          }
-          const std::uint32_t last = was(memo);
-          if (options.coherence != Coherence::kOff && last == kWasOpened && !leaf &&
-              !(was(children[0]) == kWasHidden && was(children[1]) == kWasHidden)) {
+          const auto children_hidden = [&] {
+            for (int k = 0; k < 4; ++k)
+              if (was(frame.visibility_[m.cell_id(level + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1))]) != kWasHidden)
+                return false;
+            return true;
+          };
+          const std::uint32_t last = was(*memo);
+          if (options.coherence != Coherence::kOff && last == kWasOpened && !leaf && !children_hidden()) {
             ++frame.occlusion.skipped_tests;
             remember(kWasOpened);
             return true;
@@ -650,22 +696,37 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
             }
           }
           remember(leaf ? kWasVisible : kWasOpened);
-          Box b;
-          if (half < 0) {
-            b = box_of(level, ci, cj, m.cell_z(level, ci, cj));
-          } else {
-            const Box s0 = box_of(level + 1, 2 * ci + half, 2 * cj, m.cell_z(level + 1, 2 * ci + half, 2 * cj));
-            const Box s1 = box_of(level + 1, 2 * ci + half, 2 * cj + 1, m.cell_z(level + 1, 2 * ci + half, 2 * cj + 1));
-            b = {glm::min(s0.lo, s1.lo), glm::max(s0.hi, s1.hi), std::max(s0.top, s1.top), std::min(s0.bottom, s1.bottom)};
+          const Box b = box_of(level, ci, cj, m.cell_z(level, ci, cj));
+          // A sample before the test: the projection of any point of the box lies inside its
+          // silhouette, so when the pixel under the box's centre, or under its top's centre, is
+          // still vacant the box is visible (nearly always: the pixel's centre may lie just
+          // outside the silhouette, and then a cull is missed, never made wrongly). Most boxes
+          // the walk meets are visible; this answers them for two projections and two bit
+          // lookups instead of eight projections and a test-only tiling.
+          {
+            const glm::dvec3 mid(0.5 * (static_cast<double>(b.lo.x) + b.hi.x), 0.5 * (static_cast<double>(b.lo.y) + b.hi.y),
+                                 0.5 * (static_cast<double>(b.bottom) + b.top));
+            glm::dvec2 w;
+            double depth = 0.0;
+            for (const double z : {mid.z, static_cast<double>(b.top)}) {
+              if (!project(glm::dvec3(mid.x, mid.y, z), w, depth)) return true;  // reaches the eye's plane: visible
+              const double px = std::floor(w.x), py = std::floor(w.y);
+              if (px >= 0 && py >= 0 && px < camera.width && py < camera.height &&
+                  !pyramid.covered(static_cast<int>(px), static_cast<int>(py))) {
+                ++frame.occlusion.sampled_visible;
+                return true;
+              }
+            }
           }
-          double near_depth = std::numeric_limits<double>::max(), extent = 0.0;
+          double near_depth = std::numeric_limits<double>::max();
           for (int k = 0; k < 8; ++k) {
             const glm::dvec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.top : b.bottom);
             double depth = 0.0;
             if (!project(p, corners[k], depth)) return true;  // reaches the eye's plane: visible
             near_depth = std::min(near_depth, depth);
-            extent = std::max(extent, glm::length(p));
           }
+          // No corner is farther from the origin than the corner of the largest magnitudes.
+          const double extent = glm::length(glm::max(glm::abs(glm::dvec3(b.content_lo())), glm::abs(glm::dvec3(b.content_hi()))));
           ++frame.occlusion.tested_nodes;
           const double dilation = error_px(extent, near_depth);
           if (dilation > coverage::kMaxMargin || !pyramid.hidden(corners, dilation)) return true;
@@ -677,12 +738,15 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           if (kind_of(item) != kLeaf) return;
           const int level = level_index_of(item) - m.top, ci = ci_of(item), cj = cj_of(item);
           const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
-          tile(m.vertex(i0, j0), m.vertex(i0 + s, j0), m.vertex(i0 + s, j0 + s));
-          tile(m.vertex(i0, j0), m.vertex(i0 + s, j0 + s), m.vertex(i0, j0 + s));
+          const Projected sw = project_vertex(m.vertex(i0, j0)), se = project_vertex(m.vertex(i0 + s, j0)),
+                          ne = project_vertex(m.vertex(i0 + s, j0 + s)), nw = project_vertex(m.vertex(i0, j0 + s));
+          tile_cell(sw, se, ne, nw);
           std::array<Edge, 4> edges;
           edges_of(level, ci, cj, edges);
-          for (const Edge& edge : edges)
-            if (edge.needed) tile(edge.a, edge.mid, edge.b);
+          // Each fill's ends are two of the cell's corners, in the order edges_of gives them.
+          const Projected* ends[4][2] = {{&nw, &sw}, {&se, &ne}, {&sw, &se}, {&ne, &nw}};
+          for (std::size_t k = 0; k < 4; ++k)
+            if (edges[k].needed) tile(*ends[k][0], project_vertex(edges[k].mid), *ends[k][1]);
         });
     frame.occlusion.pass_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -694,13 +758,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       back_to_front,
       [&](int level, int ci, int cj, int half) {
         const std::uint32_t cell = m.cell_id(level, ci, cj);
-        if (options.occlusion) {
-          const std::uint32_t memo = frame.visibility_[3 * static_cast<std::size_t>(cell) + static_cast<std::size_t>(half + 1)];
-          if (memo == (frame.current_stamp_ << 2 | kWasHidden)) {
-            if (half < 0 && state(cell) == kDrawn) ++frame.occlusion.culled_leaves;
-            return false;
-          }
-        }
+        if (occlusion && half < 0 && frame.visibility_[cell] == (frame.current_stamp_ << 2 | kWasHidden)) return false;
         if (half < 0 && state(cell) == kDrawn) {
           const CellContent* content = content_of(level, ci, cj);
           if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
@@ -712,6 +770,14 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         return true;
       },
       [&](std::uint64_t item) { leaves.push_back(item); });
+  if (occlusion) {
+    std::size_t drawn = 0;  // the drawn cells of the LOD choice, culled or not
+    for (int level = 0; level < m.levels; ++level)
+      for (const std::uint64_t c : by_level[static_cast<std::size_t>(level)])
+        drawn += state(m.cell_id(level, static_cast<int>(c >> 32), static_cast<int>(c & 0xFFFFFFFFu))) == kDrawn ? 1 : 0;
+    frame.occlusion.culled_leaves = drawn - frame.leaves;
+    frame.occlusion_backoff_ = frame.occlusion.culled_leaves < frame.leaves ? kOcclusionBackoff : 0;
+  }
 
   // Pass 5: expand each drawn cell into its crack fills and triangles, and each slot into its
   // polygons, in order.

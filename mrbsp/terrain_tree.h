@@ -72,6 +72,11 @@ struct TraversalOptions {
   // frame visible again with probability p_skip. Never changes the LOD choice or the image.
   Coherence coherence = Coherence::kOff;
   double p_skip = 0.5;
+  // With occlusion: when a pass culls fewer drawn cells than it keeps, leave it out of the next
+  // 8 traversals with the same Frame, then try it again (the pass costs about as much per kept
+  // triangle as drawing a hidden one saves, so below that it cannot pay). Never changes the
+  // image. Off: the pass runs in every traversal.
+  bool occlusion_adaptive = true;
   bool crack_fills = true;      // balance neighbours within one level and fill the cracks between
                                 // them (off for wireframe views, where fills only clutter)
 };
@@ -126,7 +131,11 @@ struct OcclusionStats {
   std::size_t tested_nodes = 0;   // region boxes tested against the pyramid
   std::size_t skipped_tests = 0;  // tests coherence left out
   std::size_t culled_nodes = 0;   // of those, found hidden
-  std::size_t culled_leaves = 0;  // drawn cells left out with them
+  std::size_t sampled_visible = 0;  // boxes found visible before the test, by a vacant pixel
+                                    // under their centre (not counted in tested_nodes)
+  std::size_t culled_leaves = 0;  // drawn cells of the LOD choice left out with them
+  bool ran = false;               // the pass ran in this traversal
+  bool left_out = false;          // occlusion was asked for, and occlusion_adaptive left it out
   std::size_t tiled_triangles = 0;
   double pass_ms = 0.0;
 };
@@ -154,9 +163,10 @@ struct Frame {
   std::vector<std::int32_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
-  std::vector<std::uint32_t> visibility_;  // per cell, then its two halves: stamp << 2 | what occlusion found
+  std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
+  int occlusion_backoff_ = 0;  // traversals still to leave the occlusion pass out of
 };
 
 class TerrainTree {

@@ -150,8 +150,9 @@ void run_render(const RenderOptions& o) {
     const mrbsp::OcclusionStats& occ = view.last_frame().occlusion;
     j["occlusion"] = {{"on", traversal.occlusion},          {"coherence", scene::coherence_name(traversal.coherence)},
                       {"tested_nodes", occ.tested_nodes},   {"skipped_tests", occ.skipped_tests},
-                      {"culled_nodes", occ.culled_nodes},
+                      {"culled_nodes", occ.culled_nodes},   {"sampled_visible", occ.sampled_visible},
                       {"culled_leaves", occ.culled_leaves}, {"tiled_triangles", occ.tiled_triangles},
+                      {"ran", occ.ran},                     {"left_out", occ.left_out},
                       {"pass_ms", occ.pass_ms}};
     j["volumes"] = {{"count", view.volume_count()},
                     {"input_triangles", merge.input_triangles},

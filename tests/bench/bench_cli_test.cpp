@@ -85,5 +85,43 @@ TEST(BenchCli, ASmallRunOnTheBundledDemWritesResultsReportAndPlots) {
   }
 }
 
+// The low-altitude suite's code path on a tiny case (one low view, one repetition, a 4-frame
+// flight): what it checks must hold however small the run. Its figures are not tested here.
+TEST(BenchCli, LowAltitudeSuiteCullsOnlyHiddenTrianglesAndKeepsImagesIdentical) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const std::string dem = std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt";
+  const auto r = run_terravol("bench --suites lowalt --quick --views 1 --repeats 1 --frames 4 --dem " + dem + " -o " +
+                                  dir.path().string(),
+                              300);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("low altitude N45E006 at 1 px: occlusion off / on "), std::string::npos) << r.out;
+  std::ifstream in(dir.path() / "results.json");
+  const auto j = nlohmann::json::parse(in);
+  const auto& t = j["lowalt"][0];
+  EXPECT_EQ(t["low_views"], 1);
+  ASSERT_EQ(t["occlusion"].size(), 4u) << "low and high views, 1 and 2 px";
+  for (const auto& k : t["occlusion"]) {
+    EXPECT_EQ(k["images_identical"].get<double>(), 1.0);
+    EXPECT_EQ(k["visible_culled"].get<double>(), 0.0) << "a culled triangle showed in the item buffer";
+    EXPECT_EQ(k["triangles_on_not_off"].get<double>(), 0.0);
+    EXPECT_LE(k["on"]["triangles"]["median"].get<double>(), k["off"]["triangles"]["median"].get<double>());
+    EXPECT_LE(k["hidden_culled_share"]["median"].get<double>(), 1.0);
+    EXPECT_LT(k["crack_pixel_share"]["median"].get<double>(), 1.0);
+  }
+  const auto& f = t["flight"];
+  EXPECT_EQ(f["frames"], 4);
+  // (Hierarchy updating may query more than testing every node in a frame where an opened
+  // node became hidden: its children are queried instead of it. Only the images are invariant.)
+  for (const char* mode : {"every_node", "update", "conservative"}) {
+    EXPECT_EQ(f[mode]["images_identical"].get<double>(), 1.0) << mode;
+    EXPECT_GT(f[mode]["tests_over_every_node"].get<double>(), 0.0) << mode;
+  }
+  EXPECT_EQ(f["every_node"]["tests_over_every_node"].get<double>(), 1.0);
+  std::ifstream md(dir.path() / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("## 9. Low altitude"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace terravol

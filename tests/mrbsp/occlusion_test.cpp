@@ -58,7 +58,7 @@ TEST(Occlusion, LeavesOutOnlyTerrainHiddenBehindWhatItDrawsAndKeepsTheOrder) {
     o.occlusion = true;
     tree.traverse(c, o, kept);
     culled_total += kept.occlusion.culled_leaves;
-    EXPECT_GT(kept.occlusion.tested_nodes, 0u);
+    EXPECT_GT(kept.occlusion.tested_nodes + kept.occlusion.sampled_visible, 0u);
     // The kept triangles come in the same order as without occlusion.
     const std::vector<Tri> a = triangles_of(all), k = triangles_of(kept);
     std::size_t q = 0;
@@ -97,22 +97,65 @@ TEST(Occlusion, LeavesOutOnlyTerrainHiddenBehindWhatItDrawsAndKeepsTheOrder) {
   EXPECT_GT(culled_total, 50u) << "the ridges must hide cells for the test to mean anything";
 }
 
-TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
-  const TestWindow w = ridged();
-  const TerrainTree tree(w.view(), 5);
+// Straight down from 20 km over the ridged window's centre: nothing is hidden.
+Camera from_above() {
   Camera c;
   c.eye = {3200.0, 3200.0, 20000.0};
   c.forward = {0.0, 0.0, -1.0};
   c.up = {0.0, 1.0, 0.0};
   c.width = 400;
   c.height = 240;
+  return c;
+}
+
+TEST(Occlusion, AnOverviewFromAboveCullsNothing) {
+  const TestWindow w = ridged();
+  const TerrainTree tree(w.view(), 5);
+  const Camera c = from_above();
   TraversalOptions o;
   o.occlusion = true;
   Frame f;
   tree.traverse(c, o, f);
-  EXPECT_GT(f.occlusion.tested_nodes, 0u);
+  EXPECT_GT(f.occlusion.tested_nodes + f.occlusion.sampled_visible, 0u);
   EXPECT_EQ(f.occlusion.culled_nodes, 0u);
   EXPECT_GT(f.leaves, 0u);
+}
+
+// A pass that culls fewer cells than it keeps is left out of the next 8 traversals with the
+// same Frame (they draw what the unculled traversal draws), then tried again; one that pays
+// runs every time.
+TEST(Occlusion, APassThatDoesNotPayIsLeftOutOfTheNextEightFramesThenTriedAgain) {
+  const TestWindow w = ridged();
+  const TerrainTree tree(w.view(), 5);
+  const Camera above = from_above();
+  TraversalOptions o;
+  Frame unculled, f;
+  tree.traverse(above, o, unculled);
+  o.occlusion = true;
+  for (int k = 0; k < 10; ++k) {
+    tree.traverse(above, o, f);
+    const bool probe = k == 0 || k == 9;
+    EXPECT_EQ(f.occlusion.ran, probe) << "traversal " << k;
+    EXPECT_EQ(f.occlusion.left_out, !probe) << "traversal " << k;
+    EXPECT_EQ(f.indices, unculled.indices) << "traversal " << k;
+  }
+  // Not adaptive: the pass runs every time.
+  o.occlusion_adaptive = false;
+  for (int k = 0; k < 3; ++k) {
+    tree.traverse(above, o, f);
+    EXPECT_TRUE(f.occlusion.ran);
+  }
+  // Low among the ridges, where most is hidden, it runs in every traversal.
+  o.occlusion_adaptive = true;
+  const Camera low = low_eye(3000.0, 600.0, 150.0, 0.0, -0.05);
+  Frame g;
+  std::size_t ran = 0;
+  for (int k = 0; k < 10; ++k) {
+    tree.traverse(low, o, g);
+    ran += g.occlusion.ran ? 1 : 0;
+  }
+  ASSERT_GT(g.occlusion.culled_leaves, g.leaves) << "the view must be mostly hidden for the test to mean anything";
+  EXPECT_EQ(ran, 10u);
 }
 
 // Over a flight, hierarchy updating and its conservative form test fewer cells than testing
@@ -127,15 +170,16 @@ TEST(Occlusion, CoherenceTestsFewerCellsAndKeepsEverythingVisible) {
     const Camera c = low_eye(2000.0 + 25.0 * k, 600.0 + 10.0 * k, 250.0, 0.2 - 0.004 * k, -0.05);
     TraversalOptions o;
     o.occlusion = true;
+    o.occlusion_adaptive = false;  // every frame's pass, so that the modes compare
     tree.traverse(c, o, plain);
     o.coherence = Coherence::kUpdate;
     tree.traverse(c, o, updated);
     o.coherence = Coherence::kConservative;
     o.p_skip = 0.5;
     tree.traverse(c, o, conservative);
-    tests[0] += plain.occlusion.tested_nodes;
-    tests[1] += updated.occlusion.tested_nodes;
-    tests[2] += conservative.occlusion.tested_nodes;
+    tests[0] += plain.occlusion.tested_nodes + plain.occlusion.sampled_visible;
+    tests[1] += updated.occlusion.tested_nodes + updated.occlusion.sampled_visible;
+    tests[2] += conservative.occlusion.tested_nodes + conservative.occlusion.sampled_visible;
     skipped += updated.occlusion.skipped_tests;
     const std::vector<Tri> p = triangles_of(plain);
     const std::set<Tri> ps(p.begin(), p.end());
