@@ -7,6 +7,7 @@
 
 #include "app/cli/commands.h"
 #include "app/cli/scene_options.h"
+#include "app/render/terrain_renderer.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
 #include "app/viewer/viewer.h"
@@ -60,6 +61,7 @@ void add_view_command(CLI::App& app) {
       throw std::invalid_argument("--speed: must be a positive number");
     }
     if (opt.agl && !opt.pose) throw std::invalid_argument("--agl needs --camera");
+    render::require_x_display("view");
     viewer::run_viewer(opt);
   });
 }

@@ -84,7 +84,7 @@ std::vector<std::uint8_t> profile_png(const volume::LinkProfile& l, const std::s
   }
   const volume::PathProfile& p = l.path.profile;
   const volume::FresnelAnalysis& f = l.fresnel;
-  render::require_x_display();
+  render::require_x_display("the profile plot");
 
   // The samples with both ends; the ends' ground is the DEM under the antennas.
   const std::size_t n = p.d_m.size() + 2;

@@ -87,11 +87,11 @@ Display* shared_display() {
 
 }  // namespace
 
-void require_x_display() {
+void require_x_display(const std::string& who) {
   const char* name = std::getenv("DISPLAY");
   const bool named = name != nullptr && *name != '\0';
   if (!named || shared_display() == nullptr) {
-    throw std::runtime_error("render needs an X display and none can be opened (DISPLAY=" +
+    throw std::runtime_error(who + " needs an X display and none can be opened (DISPLAY=" +
                              std::string(named ? name : "(unset)") +
                              "); run it under xvfb-run -a -s \"-screen 0 1920x1080x24\"");
   }
