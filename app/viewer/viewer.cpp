@@ -48,11 +48,13 @@
 #include <utility>
 
 #include "app/output/png_output.h"
+#include "app/output/profile_plot.h"
 #include "app/output/write_file.h"
 #include "app/render/scene_renderer.h"
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera_path.h"
 #include "app/scene/mosaic_lattice.h"
+#include "app/scene/profile_path.h"
 #include "app/scene/terrain_scene.h"
 #include "app/scene/timing.h"
 #include "app/scene/volume_layer.h"
@@ -68,6 +70,7 @@ const char* const kViewKeys =
     "arrows       turn left / right, look up / down\n"
     "left drag    look around\n"
     "Ctrl+click   the point under the cursor: lat, lon, ground, each volume's value\n"
+    "Shift+click  twice: the link profile between the two points, drawn and plotted\n"
     "Shift        4x faster; mouse wheel: speed x1.25 or /1.25\n"
     "+ / -        finer / coarser LOD (threshold / or x sqrt 2); or drag the slider\n"
     "M            LOD metric: screen-space error / projected area\n"
@@ -75,6 +78,7 @@ const char* const kViewKeys =
     "T            wireframe (triangle edges)\n"
     "G            automatic sliding of the window\n"
     "1 .. 9       show or hide volume N (and select it)\n"
+    "X            transmitter markers on / off\n"
     "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
     ", / .        lower / raise its first isosurface's level by 2 units\n"
     "P            screenshot (PNG)\n"
@@ -205,6 +209,7 @@ class Viewer {
   void key_release(const std::string& key);
   void button(bool down, int x, int y);
   void pick(int x, int y);
+  void profile_pick(int x, int y);
   void mouse_move(int x, int y);
   void wheel(int clicks);
   void leave();
@@ -228,6 +233,8 @@ class Viewer {
   bool held(const char* key) const { return held_.count(key) > 0 || tapped_.count(key) > 0; }
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void volume_key(const std::string& key);
+  void markers_key();
+  void write_profile(const io::Geodetic& from, const io::Geodetic& to);
   void record_key();
   void save_path();
 
@@ -255,6 +262,8 @@ class Viewer {
   std::filesystem::path last_screenshot_;
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
   std::optional<render::Pick> pick_;  // the last Ctrl-click's point (status file)
+  std::optional<io::Geodetic> profile_from_;  // the first Shift-click's point, until the second
+  nlohmann::ordered_json profile_status_;     // the last profile path (status file); null: none
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
   bool layout_dirty_ = true;  // the text, the key list or the legend changed since lay_out()
   int layout_size_[2] = {0, 0};
@@ -293,6 +302,8 @@ class ViewerStyle : public vtkInteractorStyle {
   void OnLeftButtonDown() override {
     if (this->Interactor->GetControlKey() != 0) {
       viewer_->pick(pos()[0], pos()[1]);
+    } else if (this->Interactor->GetShiftKey() != 0) {
+      viewer_->profile_pick(pos()[0], pos()[1]);
     } else {
       viewer_->button(true, pos()[0], pos()[1]);
     }
@@ -501,6 +512,8 @@ void Viewer::key_press(const std::string& key) {
     set_metric(metric_ == mrbsp::LodMetric::kError ? mrbsp::LodMetric::kArea : mrbsp::LodMetric::kError);
   } else if (key == "g") {
     pipeline_->set_auto_slide(!pipeline_->auto_slide());
+  } else if (key == "x") {
+    markers_key();
   } else if (key == "p") {
     screenshot_pending_ = true;
   } else if (key == "k") {
@@ -553,6 +566,100 @@ void Viewer::pick(int x, int y) {
     std::snprintf(b, sizeof b, "\n  %s: %.2f %s", v.volume.c_str(), v.value, v.units.c_str());
     message_ += b;
   }
+}
+
+// Two Shift-clicks: the first end, then the second, and the link profile between them drawn
+// over the terrain and plotted (write_profile). A third starts a new path.
+void Viewer::profile_pick(int x, int y) {
+  dirty_ = true;
+  const std::optional<render::Pick> p = pipeline_->pick(x, y);
+  if (!p) {
+    message_ = "profile: nothing under the cursor (sky, or beyond the window)";
+    return;
+  }
+  const io::Geodetic at{p->point.where.lat, p->point.where.lon, p->ground};
+  if (!profile_from_) {
+    profile_from_ = at;
+    char b[160];
+    std::snprintf(b, sizeof b, "profile from %.5f, %.5f: Shift+click its other end", at.lat, at.lon);
+    message_ = b;
+    profile_status_ = {{"from", {{"lat", at.lat}, {"lon", at.lon}, {"ground", at.h}}}, {"to", nullptr}};
+    return;
+  }
+  const io::Geodetic from = *std::exchange(profile_from_, std::nullopt);
+  write_profile(from, at);
+}
+
+// The link from an antenna above `from` to one above `to` (ViewOptions' heights and
+// frequency), as terravol profile computes it (volume::link_profile over the mosaic's samples),
+// its path merged into the tree (scene::profile_path_mesh) and its plot written atomically.
+void Viewer::write_profile(const io::Geodetic& from, const io::Geodetic& to) {
+  const auto t0 = Clock::now();
+  volume::Transmitter tx;
+  tx.lat = from.lat;
+  tx.lon = from.lon;
+  tx.height_agl = o_.profile_tx_agl;
+  tx.frequency_mhz = o_.profile_freq_mhz;
+  std::filesystem::path path = o_.profile_plot;
+  if (path.empty()) {
+    for (int k = 1; path.empty() || std::filesystem::exists(path); ++k) {
+      char name[64];
+      std::snprintf(name, sizeof name, "terravol-profile-%03d.png", k);
+      path = name;
+    }
+  }
+  try {
+    const volume::LinkProfile l = pipeline_->link_profile(tx, to.lat, to.lon, o_.profile_rx_agl);
+    const double profile_ms = ms_since(t0);
+    const render::SceneRenderer& pipeline = *pipeline_;
+    const volume::Mesh wall = scene::profile_path_mesh(
+        l, from.lat, from.lon, to.lat, to.lon, pipeline.frame(),
+        [&pipeline](double lat, double lon) { return pipeline.ground_height(lat, lon); });
+    const double merge_ms = pipeline_->set_path(wall);
+    const std::string verdict = volume::verdict(l);
+    const auto t1 = Clock::now();
+    output::write_png(path, output::profile_png(l, verdict, 1200, 600), true);
+    const double plot_ms = ms_since(t1);
+    const volume::FresnelAnalysis& f = l.fresnel;
+    profile_status_ = {{"from", {{"lat", from.lat}, {"lon", from.lon}, {"ground", from.h}}},
+                       {"to", {{"lat", to.lat}, {"lon", to.lon}, {"ground", to.h}}},
+                       {"tx_agl", o_.profile_tx_agl},
+                       {"rx_agl", o_.profile_rx_agl},
+                       {"freq_mhz", o_.profile_freq_mhz},
+                       {"distance_km", l.path.profile.distance_m / 1000.0},
+                       {"path_loss_db", l.path.path_loss_db},
+                       {"worst_clearance_m", f.worst < f.clearance_m.size() ? ordered_json(f.worst_clearance_m) : ordered_json(nullptr)},
+                       {"worst_clearance_f1", f.worst < f.clearance_m.size() ? ordered_json(f.worst_clearance_f1) : ordered_json(nullptr)},
+                       {"verdict", verdict},
+                       {"file", path.string()},
+                       {"path_triangles", wall.triangle_count()},
+                       {"tree_pieces", pipeline_->terrain().tree().merge_stats().stored_polygons},
+                       {"profile_ms", profile_ms},
+                       {"merge_ms", merge_ms},
+                       {"plot_ms", plot_ms}};
+    std::string shown = verdict;
+    if (const std::size_t at = shown.find("; path loss"); at != std::string::npos) shown.replace(at, 2, "\n  ");
+    char b[160];
+    std::snprintf(b, sizeof b, "profile %.2f km (%.0f ms): ", l.path.profile.distance_m / 1000.0, ms_since(t0));
+    message_ = b + shown + "\n  wrote " + path.string();
+  } catch (const std::exception& e) {
+    message_ = std::string("profile failed: ") + e.what();
+    profile_status_ = {{"error", e.what()}};
+    std::fprintf(stderr, "terravol: %s\n", message_.c_str());
+  }
+}
+
+// X: every volume's transmitter markers on or off; only their surfaces are merged again.
+void Viewer::markers_key() {
+  scene::VolumeLayer& volumes = pipeline_->volumes();
+  const auto t0 = Clock::now();
+  volumes.set_markers(!volumes.markers_shown());
+  const scene::MergeFigures& merge = pipeline_->remerge();
+  last_merge_ms_ = ms_since(t0);
+  char b[128];
+  std::snprintf(b, sizeof b, "transmitter markers %s: %.0f ms (%zu surfaces merged)", volumes.markers_shown() ? "on" : "off",
+                last_merge_ms_, merge.merged_surfaces);
+  message_ = b;
 }
 
 void Viewer::mouse_move(int x, int y) {
@@ -976,7 +1083,9 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                 {"tree_triangles", merge.tree_triangles},
                 {"surface_triangles", o_.style.surface_triangles},
                 {"geometry_ms", merge.geometry_ms},
-                {"merge_ms", merge.merge_ms}};
+                {"merge_ms", merge.merge_ms},
+                {"merged_surfaces", merge.merged_surfaces}};
+  j["markers"] = volumes.markers_shown();
   j["last_merge_ms"] = last_merge_ms_;
   j["message"] = message_;
   if (pick_) {
@@ -989,6 +1098,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                  {"ground", pick_->ground}, {"on_surface", pick_->point.on_surface}, {"ms", pick_->ms},
                  {"values", values}};
   }
+  if (!profile_status_.is_null()) j["profile"] = profile_status_;
   // Nothing will draw another frame until something happens: no key held, no slide read
   // ahead, no overlay refresh or screenshot due.
   j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_;
