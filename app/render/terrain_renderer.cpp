@@ -97,6 +97,11 @@ void require_x_display(const std::string& who) {
   }
 }
 
+void use_shared_display(vtkRenderWindow* window, const std::string& who) {
+  require_x_display(who);
+  window->SetDisplayId(shared_display());  // not owned: VTK leaves it open
+}
+
 TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                  const RenderSettings& settings, const ColorTexture& texture)
     : settings_(settings), shade_(shading.shade), point_rgba_(shading.rgba) {

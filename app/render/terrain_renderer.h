@@ -81,6 +81,11 @@ std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window);
 // every TerrainRenderer.
 void require_x_display(const std::string& who = "render");
 
+// Puts `window` (any VTK render window, e.g. a vtkContextView's) on that one connection
+// (require_x_display(who) first), so that closing it closes no connection: a window with its
+// own connection inside a running viewer left the viewer's X event loop polling a closed one.
+void use_shared_display(vtkRenderWindow* window, const std::string& who = "render");
+
 class TerrainRenderer {
  public:
   // positions: TerrainTree::positions(); shading: per vertex, the same count (vertex_shading).
