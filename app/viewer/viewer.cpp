@@ -258,14 +258,18 @@ class Viewer {
   // Figures.
   std::size_t frames_ = 0, screenshots_ = 0, key_presses_ = 0;
   double frame_ms_ = 0, traversal_ms_ = 0, upload_ms_ = 0, draw_ms_ = 0;
+  double overlay_ms_ = 0;  // of the frame: the overlay's text and its layout (update_overlay, lay_out)
   std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;  // slide_log_: this thread's part
   std::filesystem::path last_screenshot_;
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
   std::optional<render::Pick> pick_;  // the last Ctrl-click's point (status file)
+  Clock::time_point pick_time_;          // when it was handled
+  std::optional<double> pick_shown_ms_;  // from then to the end of the draw that first showed it
   std::optional<io::Geodetic> profile_from_;  // the first Shift-click's point, until the second
   nlohmann::ordered_json profile_status_;     // the last profile path (status file); null: none
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
   bool layout_dirty_ = true;  // the text, the key list or the legend changed since lay_out()
+  bool slider_dirty_ = true;  // the slider's texts changed since lay_out() placed them
   int layout_size_[2] = {0, 0};
   OverlayLayout layout_;
   double knob_lo_ = 0, knob_hi_ = 0;  // the knob's centre at the range's ends, window pixels
@@ -551,6 +555,8 @@ void Viewer::button(bool down, int x, int y) {
 
 // The point under the cursor, in the overlay: where, the ground, and each visible volume's value.
 void Viewer::pick(int x, int y) {
+  pick_time_ = Clock::now();
+  pick_shown_ms_.reset();
   pick_ = pipeline_->pick(x, y);
   dirty_ = true;
   if (!pick_) {
@@ -845,7 +851,7 @@ void Viewer::sync_slider() {
   slider_title_->SetInput(title.c_str());
   slider_min_->SetInput(error ? "0.25 px  finer" : "32 px^2  finer");
   slider_max_->SetInput(error ? "coarser  16 px" : "coarser  32768 px^2");
-  layout_dirty_ = true;  // the title's width changed
+  layout_dirty_ = slider_dirty_ = true;  // the title's width changed
 }
 
 void Viewer::draw_frame() {
@@ -865,10 +871,13 @@ void Viewer::draw_frame() {
   const double speed = scene::flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
   traversal_ms_ = f.traversal_ms;
   upload_ms_ = f.upload_ms;
+  const auto overlay_t0 = Clock::now();
   update_overlay(agl, speed);
   lay_out();
+  overlay_ms_ = ms_since(overlay_t0);
   draw_ms_ = pipeline_->draw();
   frame_ms_ = ms_since(t0);
+  if (pick_ && !pick_shown_ms_) pick_shown_ms_ = ms_since(pick_time_);
   if (frames_ > 0) {  // the first frame compiles shaders and uploads every vertex
     frame_log_.push_back(frame_ms_);
     traversal_log_.push_back(traversal_ms_);
@@ -921,7 +930,8 @@ void Viewer::lay_out() {
   vtkRenderWindow* win = pipeline_->renderer().window();
   const int* size = win->GetSize();
   const int W = size[0], H = size[1];
-  if (!layout_dirty_ && W == layout_size_[0] && H == layout_size_[1]) return;
+  const bool resized = W != layout_size_[0] || H != layout_size_[1];
+  if (!layout_dirty_ && !resized) return;
   layout_dirty_ = false;
   layout_size_[0] = W;
   layout_size_[1] = H;
@@ -950,48 +960,53 @@ void Viewer::lay_out() {
   layout_ = lay_out_overlay(in);
 
   // The slider: the panel, the title at its top, the tube across its middle, the end labels
-  // at its bottom.
-  const Box& sb = layout_.slider;
-  const double nx0 = double(sb.x) / W, nx1 = double(sb.right()) / W;
-  const double ny0 = 1.0 - double(sb.bottom()) / H, ny1 = 1.0 - double(sb.y) / H;
-  slider_corners_->SetPoint(0, nx0, ny0, 0.0);
-  slider_corners_->SetPoint(1, nx1, ny0, 0.0);
-  slider_corners_->SetPoint(2, nx1, ny1, 0.0);
-  slider_corners_->SetPoint(3, nx0, ny1, 0.0);
-  slider_corners_->Modified();
-  const double tube_y = H - (sb.y + kSliderTubeY);
-  slider_rep_->GetPoint1Coordinate()->SetValue(sb.x + kSliderInset, tube_y);
-  slider_rep_->GetPoint2Coordinate()->SetValue(sb.right() - kSliderInset, tube_y);
-  // VTK sizes the slider's parts as fractions of the window: lengths of its width, widths of
-  // its height (9.1), so that these are pixels.
-  slider_rep_->SetEndCapLength(8.0 / W);
-  slider_rep_->SetSliderLength(14.0 / W);
-  slider_rep_->SetSliderWidth(28.0 / H);
-  slider_rep_->SetTubeWidth(8.0 / H);
-  slider_rep_->SetEndCapWidth(22.0 / H);
-  // The title and the end labels at the largest size that fits the panel's width.
-  const int inner = sb.w - 2 * kSliderPad;
-  int title_font = 16;
-  while (title_font > 7 && measure(slider_title_)(title_font)[0] > inner) --title_font;
-  slider_title_->GetTextProperty()->SetFontSize(title_font);
-  int end_font = 13;
-  while (end_font > 6 && measure(slider_min_)(end_font)[0] + measure(slider_max_)(end_font)[0] + 12 > inner) --end_font;
-  slider_min_->GetTextProperty()->SetFontSize(end_font);
-  slider_max_->GetTextProperty()->SetFontSize(end_font);
-  slider_title_->SetPosition(sb.x + kSliderPad, H - (sb.y + kSliderPad));
-  slider_min_->SetPosition(sb.x + kSliderPad, H - (sb.bottom() - kSliderPad));
-  slider_max_->SetPosition(sb.right() - kSliderPad, H - (sb.bottom() - kSliderPad));
-  const double value = slider_rep_->GetValue();
-  slider_rep_->SetValue(slider_rep_->GetMinimumValue());
-  const auto knob_x = [&] {
-    const Box k = slider_rep_->knob_box(H);
-    return k.x + 0.5 * k.w;
-  };
-  knob_lo_ = knob_x();
-  slider_rep_->SetValue(slider_rep_->GetMaximumValue());
-  knob_hi_ = knob_x();
-  slider_rep_->SetValue(value);
-  slider_rep_->BuildRepresentation();
+  // at its bottom; placed again only when the window's size or its texts changed (its box
+  // depends on nothing else), since measuring its texts and building its representation cost
+  // milliseconds that a changed overlay message need not pay.
+  if (resized || slider_dirty_) {
+    slider_dirty_ = false;
+    const Box& sb = layout_.slider;
+    const double nx0 = double(sb.x) / W, nx1 = double(sb.right()) / W;
+    const double ny0 = 1.0 - double(sb.bottom()) / H, ny1 = 1.0 - double(sb.y) / H;
+    slider_corners_->SetPoint(0, nx0, ny0, 0.0);
+    slider_corners_->SetPoint(1, nx1, ny0, 0.0);
+    slider_corners_->SetPoint(2, nx1, ny1, 0.0);
+    slider_corners_->SetPoint(3, nx0, ny1, 0.0);
+    slider_corners_->Modified();
+    const double tube_y = H - (sb.y + kSliderTubeY);
+    slider_rep_->GetPoint1Coordinate()->SetValue(sb.x + kSliderInset, tube_y);
+    slider_rep_->GetPoint2Coordinate()->SetValue(sb.right() - kSliderInset, tube_y);
+    // VTK sizes the slider's parts as fractions of the window: lengths of its width, widths of
+    // its height (9.1), so that these are pixels.
+    slider_rep_->SetEndCapLength(8.0 / W);
+    slider_rep_->SetSliderLength(14.0 / W);
+    slider_rep_->SetSliderWidth(28.0 / H);
+    slider_rep_->SetTubeWidth(8.0 / H);
+    slider_rep_->SetEndCapWidth(22.0 / H);
+    // The title and the end labels at the largest size that fits the panel's width.
+    const int inner = sb.w - 2 * kSliderPad;
+    int title_font = 16;
+    while (title_font > 7 && measure(slider_title_)(title_font)[0] > inner) --title_font;
+    slider_title_->GetTextProperty()->SetFontSize(title_font);
+    int end_font = 13;
+    while (end_font > 6 && measure(slider_min_)(end_font)[0] + measure(slider_max_)(end_font)[0] + 12 > inner) --end_font;
+    slider_min_->GetTextProperty()->SetFontSize(end_font);
+    slider_max_->GetTextProperty()->SetFontSize(end_font);
+    slider_title_->SetPosition(sb.x + kSliderPad, H - (sb.y + kSliderPad));
+    slider_min_->SetPosition(sb.x + kSliderPad, H - (sb.bottom() - kSliderPad));
+    slider_max_->SetPosition(sb.right() - kSliderPad, H - (sb.bottom() - kSliderPad));
+    const double value = slider_rep_->GetValue();
+    slider_rep_->SetValue(slider_rep_->GetMinimumValue());
+    const auto knob_x = [&] {
+      const Box k = slider_rep_->knob_box(H);
+      return k.x + 0.5 * k.w;
+    };
+    knob_lo_ = knob_x();
+    slider_rep_->SetValue(slider_rep_->GetMaximumValue());
+    knob_hi_ = knob_x();
+    slider_rep_->SetValue(value);
+    slider_rep_->BuildRepresentation();
+  }
 
   // The legend, the text and the key list.
   const bool legend = !layout_.legend.empty();
@@ -1058,6 +1073,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["traversal_ms"] = traversal_ms_;
   j["upload_ms"] = upload_ms_;
   j["draw_ms"] = draw_ms_;
+  j["overlay_ms"] = overlay_ms_;
   j["slides"] = pipeline_->slides();
   j["last_slide_ms"] = slide.tree_ms + slide.vertices_ms;  // this thread's part
   j["last_slide_parts_ms"] = {{"read_window", slide.read_ms},
@@ -1096,6 +1112,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
     }
     j["pick"] = {{"lat", g.lat},       {"lon", g.lon},       {"height", g.h},
                  {"ground", pick_->ground}, {"on_surface", pick_->point.on_surface}, {"ms", pick_->ms},
+                 {"to_overlay_ms", pick_shown_ms_ ? ordered_json(*pick_shown_ms_) : ordered_json(nullptr)},
                  {"values", values}};
   }
   if (!profile_status_.is_null()) j["profile"] = profile_status_;
