@@ -193,6 +193,17 @@ ordered_json box_json(const Box& b) {
 
 constexpr auto kOverlayPeriod = std::chrono::milliseconds(250);
 
+// `given`, or when it is empty the first STEM-NNN.png (NNN from 001) not in the current folder.
+std::filesystem::path given_or_next_free(const std::filesystem::path& given, const char* stem) {
+  std::filesystem::path path = given;
+  for (int k = 1; path.empty() || (given.empty() && std::filesystem::exists(path)); ++k) {
+    char name[96];
+    std::snprintf(name, sizeof name, "%s-%03d.png", stem, k);
+    path = name;
+  }
+  return path;
+}
+
 class ViewerStyle;
 
 class Viewer {
@@ -606,14 +617,7 @@ void Viewer::write_profile(const io::Geodetic& from, const io::Geodetic& to) {
   tx.lon = from.lon;
   tx.height_agl = o_.profile_tx_agl;
   tx.frequency_mhz = o_.profile_freq_mhz;
-  std::filesystem::path path = o_.profile_plot;
-  if (path.empty()) {
-    for (int k = 1; path.empty() || std::filesystem::exists(path); ++k) {
-      char name[64];
-      std::snprintf(name, sizeof name, "terravol-profile-%03d.png", k);
-      path = name;
-    }
-  }
+  const std::filesystem::path path = given_or_next_free(o_.profile_plot, "terravol-profile");
   try {
     const volume::LinkProfile l = pipeline_->link_profile(tx, to.lat, to.lon, o_.profile_rx_agl);
     const double profile_ms = ms_since(t0);
@@ -1020,14 +1024,7 @@ void Viewer::lay_out() {
 }
 
 void Viewer::save_screenshot() {
-  std::filesystem::path path = o_.screenshot;
-  if (path.empty()) {
-    for (int k = 1; path.empty() || std::filesystem::exists(path); ++k) {
-      char name[64];
-      std::snprintf(name, sizeof name, "terravol-view-%03d.png", k);
-      path = name;
-    }
-  }
+  const std::filesystem::path path = given_or_next_free(o_.screenshot, "terravol-view");
   try {
     output::write_png(path, output::window_png(pipeline_->renderer().window()), true);
     ++screenshots_;
