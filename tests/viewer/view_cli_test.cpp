@@ -945,7 +945,8 @@ TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
 TEST(ViewCli, HelpListsTheKeyBindings) {
   const auto r = test::run_terravol("view --help");
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* text : {"W / S", "wireframe", "LOD colours", "sliding", "Esc", "--status", "--threshold"}) {
+  for (const char* text : {"W / S", "wireframe", "LOD colours", "sliding", "Esc", "--status", "--threshold",
+                           "Shift+click", "transmitter markers", "--profile-plot"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
 }
@@ -971,6 +972,26 @@ TEST(ViewCli, ACameraBeyondTheDemSeesTheTileAndFlyingAwayStopsAt200Km) {
   v.hold_until("s", [](const json&) { return false; }, 1.0);  // on against the limit for a second
   const json s1 = v.settle();
   EXPECT_NEAR(s1["camera"]["lat"].get<double>(), 45.0 - 199.8 / 111.2, 1e-3) << "stopped 200 km south of the tile";
+}
+
+// The profile options' bad values, and no display: one line each, before any window opens.
+TEST(ViewCli, BadProfileOptionsOrNoDisplayFailWithOneLine) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"view " + bundled_dem() + " --profile-agl 30", "terravol: --profile-agl 30: expected TX,RX"},
+      {"view " + bundled_dem() + " --profile-agl 30,-1", "terravol: --profile-agl 30,-1: expected TX,RX"},
+      {"view " + bundled_dem() + " --profile-freq 0", "terravol: --profile-freq: must be within (0, 100000] MHz"},
+      {"view " + bundled_dem() + " --profile-plot /nonexistent-folder/p.png",
+       "terravol: --profile-plot /nonexistent-folder/p.png: folder /nonexistent-folder does not exist"},
+  };
+  for (const auto& [args, prefix] : cases) {
+    const auto r = test::run_terravol(args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  const auto r = test::run_terravol_under("env -u DISPLAY", "view " + bundled_dem());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err.rfind("terravol: view needs an X display", 0), 0u) << r.err;
 }
 
 }  // namespace
