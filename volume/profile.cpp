@@ -71,6 +71,7 @@ LinkProfile link_profile(const io::Grid& dem, const Transmitter& tx, double rx_l
   }
   l.tx_ground_m = p.tx_height_m - tx.height_agl;
   l.rx_ground_m = p.rx_height_m - rx_height_agl;
+  l.model = options.model;
   return l;
 }
 
@@ -93,9 +94,13 @@ std::string verdict(const LinkProfile& l) {
     }
   }
   const RfPath& p = l.path;
-  s += "; path loss " + format("%.1f", p.path_loss_db) + " dB (free space " + format("%.1f", p.free_space_db) +
-       " dB + diffraction " + format("%.1f", p.diffraction_db) + " dB over " + std::to_string(p.edges.size()) +
-       (p.edges.size() == 1 ? " edge" : " edges");
+  s += "; path loss " + format("%.1f", p.path_loss_db) + " dB (free space " + format("%.1f", p.free_space_db);
+  if (l.model == RfModel::kItm) {
+    s += " dB + ITM " + format("%.1f", p.diffraction_db) + " dB beyond free space";
+  } else {
+    s += " dB + diffraction " + format("%.1f", p.diffraction_db) + " dB over " + std::to_string(p.edges.size()) +
+         (p.edges.size() == 1 ? " edge" : " edges");
+  }
   if (p.antenna_gain_db != 0.0) s += " + antenna pattern " + format("%.1f", -p.antenna_gain_db) + " dB";
   return s + ")";
 }

@@ -46,6 +46,7 @@ struct LinkProfile {
   std::vector<double> lat, lon;  // per sample, degrees: the straight line in latitude and
                                  // longitude the model samples
   double tx_ground_m = 0.0, rx_ground_m = 0.0;  // the DEM under the antennas
+  RfModel model = RfModel::kDeygout;            // the model that gave path's loss
 };
 
 // Throws what rf_path throws.
@@ -54,7 +55,8 @@ LinkProfile link_profile(const io::Grid& dem, const Transmitter& tx, double rx_l
 
 // One line for people: whether the link is clear, where and how badly it is obstructed, and the
 // path loss, e.g. "obstructed: terrain 35.2 m above the line of sight at 5.12 km (-1.42 F1);
-// path loss 143.2 dB (free space 113.3 dB + diffraction 29.9 dB over 2 edges)".
+// path loss 143.2 dB (free space 113.3 dB + diffraction 29.9 dB over 2 edges)"; with ITM the
+// loss's second term is "ITM 27.4 dB beyond free space".
 std::string verdict(const LinkProfile& profile);
 
 }  // namespace terravol::volume

@@ -128,6 +128,7 @@ void run_fly(const FlyOptions& o) {
   const double threshold_scale = traversal.metric == mrbsp::LodMetric::kError ? factor : factor * factor;
   const double default_fov = scene.camera ? scene.camera->fov_y_deg : 45.0;
 
+  render::require_x_display("fly");
   // Outputs: nothing is replaced without --force; a PNG folder resumes only what it started.
   if (!o.stats.empty() && !o.force && std::filesystem::exists(o.stats)) {
     throw std::runtime_error(o.stats.string() + ": exists (use --force to overwrite)");

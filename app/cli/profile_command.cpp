@@ -1,6 +1,6 @@
-// `terravol profile --from LAT,LON,AGL --to LAT,LON,AGL --dem DEM... [-o profile.png] [--csv FILE]`:
-// a point-to-point link profile (volume/profile.h) with its plot (app/profile_plot.h), its
-// samples as CSV, and a verdict line on stdout.
+// `terravol profile --from LAT,LON,AGL --to LAT,LON,AGL --dem DEM... [--model deygout|itm]
+// [-o profile.png] [--csv FILE]`: a point-to-point link profile (volume/profile.h) with its plot
+// (app/profile_plot.h), its samples as CSV, and a verdict line on stdout.
 #include <GeographicLib/Geodesic.hpp>
 
 #include <algorithm>
@@ -20,6 +20,7 @@
 #include "app/output/png_output.h"
 #include "app/output/profile_plot.h"
 #include "app/output/write_file.h"
+#include "app/render/terrain_renderer.h"
 #include "io/mosaic.h"
 #include "volume/profile.h"
 #include "volume/propagation.h"
@@ -34,7 +35,15 @@ struct ProfileOptions {
   std::filesystem::path output, csv;
   double frequency_mhz = 900.0;
   int edge_depth = 2;
+  ModelArgs model;  // --model and ITM's parameters
+  CLI::Option* edge_depth_option = nullptr;
   bool force = false;
+
+  std::string frequency_text() const {
+    char b[48];
+    std::snprintf(b, sizeof b, "%g", frequency_mhz);
+    return b;
+  }
 };
 
 bool whole_number(const std::string& text, double& out) {
@@ -108,13 +117,28 @@ void run_profile(const ProfileOptions& o) {
   volume::Transmitter tx = parse_tx(o.from, "--from " + o.from);
   const auto rx = parse_point(o.to, "--to");
   if (!(o.frequency_mhz > 0.0 && o.frequency_mhz <= 100000.0)) {
-    char b[48];
-    std::snprintf(b, sizeof b, "%g", o.frequency_mhz);
-    throw std::runtime_error("--freq " + std::string(b) + ": must be within (0, 100000] MHz");
+    throw std::runtime_error("--freq " + o.frequency_text() + ": must be within (0, 100000] MHz");
   }
   tx.frequency_mhz = o.frequency_mhz;
   volume::RfOptions options;
+  options.model = parse_model(o.model);
+  // The k-factor raises the terrain for the clearance (and Deygout's loss); ITM takes its own
+  // Earth from the refractivity, as in terravol rf.
   options.k_factor = parse_k_factor(o.k_factor);
+  if (options.model == volume::RfModel::kItm) {
+    if (o.edge_depth_option->count() > 0) throw std::runtime_error("--edge-depth: only with --model deygout");
+    options.itm = itm_parameters(o.model);
+    if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
+      throw std::runtime_error("--freq " + o.frequency_text() + ": ITM takes frequencies within [20, 20000] MHz");
+    }
+    const auto antenna = [](const std::string& option, const std::string& text, double agl) {
+      if (agl < 0.5 || agl > 3000.0) {
+        throw std::runtime_error(option + " " + text + ": ITM takes antenna heights within [0.5, 3000] m above ground");
+      }
+    };
+    antenna("--from", o.from, tx.height_agl);
+    antenna("--to", o.to, rx[2]);
+  }
   if (o.edge_depth < 1 || o.edge_depth > 16) {
     throw std::runtime_error("--edge-depth " + std::to_string(o.edge_depth) + ": must be within [1, 16]");
   }
@@ -127,6 +151,7 @@ void run_profile(const ProfileOptions& o) {
   }
   if (!o.output.empty()) output::check_output_path(o.output, "-o", ".png", o.force);
   if (!o.csv.empty()) output::check_output_path(o.csv, "--csv", ".csv", o.force);
+  if (!o.output.empty()) render::require_x_display("profile -o");  // before any work
   double distance = 0.0;
   GeographicLib::Geodesic::WGS84().Inverse(tx.lat, tx.lon, rx[0], rx[1], distance);
   if (distance < 1.0) throw std::runtime_error("--to " + o.to + ": the same point as --from (less than 1 m away)");
@@ -178,8 +203,8 @@ void run_profile(const ProfileOptions& o) {
                 p.profile.d_m[f.worst] / 1000.0, l.lat[f.worst], l.lon[f.worst], f.worst_clearance_m,
                 f.worst_clearance_f1, f.f1_m[f.worst]);
   }
-  std::printf("  path loss %.3f dB = free space %.3f dB + diffraction %.3f dB", p.path_loss_db, p.free_space_db,
-              p.diffraction_db);
+  std::printf("  path loss %.3f dB = free space %.3f dB + %s %.3f dB", p.path_loss_db, p.free_space_db,
+              options.model == volume::RfModel::kItm ? "ITM beyond free space" : "diffraction", p.diffraction_db);
   if (tx.antenna) std::printf(" - antenna pattern %.3f dB (departure %+.3f deg)", p.antenna_gain_db, p.departure_deg);
   std::printf("\n");
   if (!o.output.empty()) std::printf("  wrote %s\n", o.output.string().c_str());
@@ -201,8 +226,13 @@ void add_profile_command(CLI::App& app) {
   cmd->add_option("--to", o->to, "Receiver LAT,LON,HEIGHT_AGL")->required();
   cmd->add_option("--dem", o->dems, "DEM files or folders of tiles (one mosaic)")->required();
   cmd->add_option("--freq", o->frequency_mhz, "Frequency, MHz")->capture_default_str();
-  cmd->add_option("--k-factor", o->k_factor, "Effective Earth radius factor, a number or a fraction")->capture_default_str();
-  cmd->add_option("--edge-depth", o->edge_depth, "Deygout recursion levels, as for terravol rf")->capture_default_str();
+  cmd->add_option("--k-factor", o->k_factor,
+                  "Effective Earth radius factor, a number or a fraction: the terrain's bulge for the clearance "
+                  "(and Deygout's loss; ITM takes its Earth from --refractivity)")
+      ->capture_default_str();
+  o->edge_depth_option =
+      cmd->add_option("--edge-depth", o->edge_depth, "Deygout recursion levels, as for terravol rf")->capture_default_str();
+  add_model_options(*cmd, o->model);
   cmd->add_option("-o,--output", o->output, "The plot, .png (needs an X display)");
   cmd->add_option("--csv", o->csv, "The samples, .csv");
   cmd->add_option("--size", o->size, "The plot's size, WIDTHxHEIGHT pixels")->capture_default_str();

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -158,6 +159,84 @@ std::vector<double> parse_heights(const std::string& text) {
       bad("heights must be evenly spaced (a regular lattice)");
   }
   return h;
+}
+
+void add_model_options(CLI::App& cmd, ModelArgs& a) {
+  cmd.add_option("--model", a.model, "Propagation model: deygout or itm (Longley-Rice point-to-point)")
+      ->capture_default_str();
+  a.itm_options = {
+      cmd.add_option("--polarization", a.polarization, "ITM: horizontal or vertical")->capture_default_str(),
+      cmd.add_option("--permittivity", a.permittivity, "ITM: relative permittivity of the ground")->capture_default_str(),
+      cmd.add_option("--conductivity", a.conductivity, "ITM: ground conductivity, S/m")->capture_default_str(),
+      cmd.add_option("--refractivity", a.refractivity,
+                     "ITM: surface refractivity at sea level N_0, N-units (SPLAT!'s bending constant)")
+          ->capture_default_str(),
+      cmd.add_option("--climate", a.climate,
+                     "ITM: radio climate 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 "
+                     "desert, 5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)")
+          ->capture_default_str(),
+      cmd.add_option("--time", a.time, "ITM: fraction of time the loss is not exceeded")->capture_default_str(),
+      cmd.add_option("--location", a.location, "ITM: fraction of locations")->capture_default_str(),
+      cmd.add_option("--situation", a.situation, "ITM: fraction of situations (confidence)")->capture_default_str(),
+      cmd.add_option("--mdvar", a.mdvar,
+                     "ITM: variability mode 0..3 (single message, accidental, mobile, broadcast), +10 without "
+                     "location variability, +20 without direct situation variability (SPLAT!: 12)")
+          ->capture_default_str(),
+  };
+}
+
+volume::RfModel parse_model(const ModelArgs& a) {
+  if (a.model == "itm") return volume::RfModel::kItm;
+  if (a.model != "deygout") throw std::runtime_error("--model " + a.model + ": must be itm or deygout");
+  for (const CLI::Option* option : a.itm_options) {
+    if (option->count() > 0) throw std::runtime_error(option->get_name() + ": only with --model itm");
+  }
+  return volume::RfModel::kDeygout;
+}
+
+volume::ItmParameters itm_parameters(const ModelArgs& o) {
+  volume::ItmParameters p;
+  if (o.polarization == "horizontal" || o.polarization == "h") {
+    p.polarization = volume::ItmPolarization::kHorizontal;
+  } else if (o.polarization == "vertical" || o.polarization == "v") {
+    p.polarization = volume::ItmPolarization::kVertical;
+  } else {
+    throw std::runtime_error("--polarization " + o.polarization + ": must be horizontal or vertical");
+  }
+  auto range = [](const char* option, double v, bool ok, const char* what) {
+    if (ok) return;
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    throw std::runtime_error(std::string(option) + " " + b + ": must be within " + what);
+  };
+  range("--permittivity", o.permittivity, o.permittivity > 1.0 && o.permittivity <= 100.0, "(1, 100]");
+  range("--conductivity", o.conductivity, o.conductivity > 0.0 && o.conductivity <= 100.0, "(0, 100] S/m");
+  range("--refractivity", o.refractivity, o.refractivity >= 250.0 && o.refractivity <= 400.0, "[250, 400] N-units");
+  range("--time", o.time, o.time > 0.0 && o.time < 1.0, "(0, 1)");
+  range("--location", o.location, o.location > 0.0 && o.location < 1.0, "(0, 1)");
+  range("--situation", o.situation, o.situation > 0.0 && o.situation < 1.0, "(0, 1)");
+  if (o.climate < 1 || o.climate > 7) {
+    throw std::runtime_error("--climate " + std::to_string(o.climate) +
+                             ": must be within 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 "
+                             "desert, 5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)");
+  }
+  const int mode = o.mdvar % 10;
+  if (o.mdvar < 0 || o.mdvar > 33 || mode > 3) {
+    throw std::runtime_error("--mdvar " + std::to_string(o.mdvar) +
+                             ": must be 0..3 (single message, accidental, mobile, broadcast), plus 10 without location "
+                             "variability, plus 20 without direct situation variability");
+  }
+  p.permittivity = o.permittivity;
+  p.conductivity = o.conductivity;
+  p.refractivity = o.refractivity;
+  p.climate = static_cast<volume::ItmClimate>(o.climate);
+  p.time = o.time;
+  p.location = o.location;
+  p.situation = o.situation;
+  p.variability = static_cast<volume::ItmVariability>(mode);
+  p.location_variability = (o.mdvar % 20) < 10;
+  p.situation_variability = o.mdvar < 20;
+  return p;
 }
 
 }  // namespace terravol::app::cli

@@ -1,6 +1,9 @@
 // Parsing the transmitter and receiver-height options that `terravol rf` and
-// `terravol splat-volume` share. Errors are std::runtime_error with one line naming the option.
+// `terravol splat-volume` share, and the model options of `terravol rf` and `terravol profile`.
+// Errors are std::runtime_error with one line naming the option.
 #pragma once
+
+#include <CLI/CLI.hpp>
 
 #include <filesystem>
 #include <string>
@@ -32,5 +35,23 @@ std::vector<volume::Transmitter> read_tx_file(const std::string& path);
 // metres above ground within [0, 100000], increasing and evenly spaced (to 1e-6 m).
 // Throws "--heights TEXT: what is wrong".
 std::vector<double> parse_heights(const std::string& text);
+
+// --model (deygout or itm) and ITM's parameters, at SPLAT!'s .lrp defaults.
+struct ModelArgs {
+  std::string model = "deygout";
+  std::string polarization = "horizontal";
+  double permittivity = 15.0, conductivity = 0.005, refractivity = 301.0;
+  int climate = 5, mdvar = 12;
+  double time = 0.5, location = 0.5, situation = 0.5;
+  std::vector<CLI::Option*> itm_options;  // set by add_model_options
+};
+// Adds --model, --polarization, --permittivity, --conductivity, --refractivity, --climate,
+// --time, --location, --situation and --mdvar to `cmd`, into `args` (which must outlive it).
+void add_model_options(CLI::App& cmd, ModelArgs& args);
+// The model --model names. Throws "--model TEXT: must be itm or deygout", and "--OPTION: only
+// with --model itm" when an ITM option was given with Deygout.
+volume::RfModel parse_model(const ModelArgs& args);
+// ITM's parameters; each bad value is one line naming its option and its range.
+volume::ItmParameters itm_parameters(const ModelArgs& args);
 
 }  // namespace terravol::app::cli

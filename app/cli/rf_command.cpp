@@ -44,13 +44,8 @@ std::string fmt(double v) {
 struct RfCommandOptions {
   std::vector<std::string> txs;
   std::string tx_file, heights;
-  std::string model = "deygout";
-  // ITM's parameters, SPLAT!'s .lrp defaults.
-  std::string polarization = "horizontal";
-  double permittivity = 15.0, conductivity = 0.005, refractivity = 301.0;
-  int climate = 5, mdvar = 12;
-  double time = 0.5, location = 0.5, situation = 0.5;
-  std::vector<std::string> given;  // the model-specific options given on the command line
+  ModelArgs model;  // --model and ITM's parameters
+  std::vector<std::string> given;  // the Deygout options given on the command line
   std::vector<std::filesystem::path> dems;
   std::filesystem::path output;
   double radius_km = 20.0;
@@ -70,56 +65,11 @@ struct Setup {
   volume::RfOptions options;
 };
 
-// The options only one model takes.
+// The options only Deygout takes.
 constexpr const char* kDeygoutOptions[] = {"--k-factor", "--edge-depth"};
-constexpr const char* kItmOptions[] = {"--polarization", "--permittivity", "--conductivity", "--refractivity", "--climate",
-                                       "--time", "--location", "--situation", "--mdvar"};
 
 bool given(const RfCommandOptions& o, const std::string& name) {
   return std::find(o.given.begin(), o.given.end(), name) != o.given.end();
-}
-
-// The ITM parameters from the command line; each bad value is one line naming its option.
-volume::ItmParameters itm_parameters(const RfCommandOptions& o) {
-  volume::ItmParameters p;
-  if (o.polarization == "horizontal" || o.polarization == "h") {
-    p.polarization = volume::ItmPolarization::kHorizontal;
-  } else if (o.polarization == "vertical" || o.polarization == "v") {
-    p.polarization = volume::ItmPolarization::kVertical;
-  } else {
-    throw std::runtime_error("--polarization " + o.polarization + ": must be horizontal or vertical");
-  }
-  auto range = [](const char* option, double v, bool ok, const char* what) {
-    if (!ok) throw std::runtime_error(std::string(option) + " " + fmt(v) + ": must be within " + what);
-  };
-  range("--permittivity", o.permittivity, o.permittivity > 1.0 && o.permittivity <= 100.0, "(1, 100]");
-  range("--conductivity", o.conductivity, o.conductivity > 0.0 && o.conductivity <= 100.0, "(0, 100] S/m");
-  range("--refractivity", o.refractivity, o.refractivity >= 250.0 && o.refractivity <= 400.0, "[250, 400] N-units");
-  range("--time", o.time, o.time > 0.0 && o.time < 1.0, "(0, 1)");
-  range("--location", o.location, o.location > 0.0 && o.location < 1.0, "(0, 1)");
-  range("--situation", o.situation, o.situation > 0.0 && o.situation < 1.0, "(0, 1)");
-  if (o.climate < 1 || o.climate > 7) {
-    throw std::runtime_error("--climate " + std::to_string(o.climate) +
-                             ": must be within 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 "
-                             "desert, 5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)");
-  }
-  const int mode = o.mdvar % 10;
-  if (o.mdvar < 0 || o.mdvar > 33 || mode > 3) {
-    throw std::runtime_error("--mdvar " + std::to_string(o.mdvar) +
-                             ": must be 0..3 (single message, accidental, mobile, broadcast), plus 10 without location "
-                             "variability, plus 20 without direct situation variability");
-  }
-  p.permittivity = o.permittivity;
-  p.conductivity = o.conductivity;
-  p.refractivity = o.refractivity;
-  p.climate = static_cast<volume::ItmClimate>(o.climate);
-  p.time = o.time;
-  p.location = o.location;
-  p.situation = o.situation;
-  p.variability = static_cast<volume::ItmVariability>(mode);
-  p.location_variability = (o.mdvar % 20) < 10;
-  p.situation_variability = o.mdvar < 20;
-  return p;
 }
 
 // How a message names transmitter t: its --tx text when it is the only one given.
@@ -130,17 +80,10 @@ std::string tx_label(const RfCommandOptions& o, const std::vector<volume::Transm
 
 Setup check_options(const RfCommandOptions& o) {
   Setup s;
-  if (o.model == "itm") {
-    s.options.model = volume::RfModel::kItm;
-  } else if (o.model != "deygout") {
-    throw std::runtime_error("--model " + o.model + ": must be itm or deygout");
-  }
+  s.options.model = parse_model(o.model);
   const bool itm = s.options.model == volume::RfModel::kItm;
   for (const char* name : kDeygoutOptions) {
     if (itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model deygout");
-  }
-  for (const char* name : kItmOptions) {
-    if (!itm && given(o, name)) throw std::runtime_error(std::string(name) + ": only with --model itm");
   }
   if (o.txs.empty() && o.tx_file.empty()) throw std::runtime_error("give the transmitters: --tx (once or more) or --tx-file");
   for (const auto& t : o.txs) s.transmitters.push_back(parse_tx(t));
@@ -151,7 +94,7 @@ Setup check_options(const RfCommandOptions& o) {
   const std::string heights = o.heights.empty() ? (itm ? "10:2010:50" : "0:2000:50") : o.heights;
   s.grid.heights_agl = parse_heights(heights);
   if (itm) {
-    s.options.itm = itm_parameters(o);
+    s.options.itm = itm_parameters(o.model);
     for (std::size_t t = 0; t < s.transmitters.size(); ++t) {
       const volume::Transmitter& tx = s.transmitters[t];
       if (tx.frequency_mhz < 20.0 || tx.frequency_mhz > 20000.0) {
@@ -390,8 +333,7 @@ void add_rf_command(CLI::App& app) {
       "--model itm), or the signals and best server of several, written as .vdb; under mpirun the work is split "
       "over the ranks");
   auto o = std::make_shared<RfCommandOptions>();
-  cmd->add_option("--model", o->model, "Propagation model: deygout or itm (Longley-Rice point-to-point)")
-      ->capture_default_str();
+  add_model_options(*cmd, o->model);
   cmd->add_option("--tx", o->txs,
                   "Transmitter LAT,LON,HEIGHT_AGL[,FREQ_MHZ[,ERP_W]][,name=NAME][,pattern=FILE.az[:FILE.el]]"
                   "[,azimuth=DEG][,tilt=DEG]: degrees, metres above ground, MHz (default 900), W relative to a "
@@ -415,31 +357,12 @@ void add_rf_command(CLI::App& app) {
   cmd->add_option("--edge-depth", o->edge_depth,
                   "Deygout: recursion levels (1: principal edge only; 2: plus one secondary edge each side)")
       ->capture_default_str();
-  cmd->add_option("--polarization", o->polarization, "ITM: horizontal or vertical")->capture_default_str();
-  cmd->add_option("--permittivity", o->permittivity, "ITM: relative permittivity of the ground")->capture_default_str();
-  cmd->add_option("--conductivity", o->conductivity, "ITM: ground conductivity, S/m")->capture_default_str();
-  cmd->add_option("--refractivity", o->refractivity,
-                  "ITM: surface refractivity at sea level N_0, N-units (SPLAT!'s bending constant)")
-      ->capture_default_str();
-  cmd->add_option("--climate", o->climate,
-                  "ITM: radio climate 1..7 (1 equatorial, 2 continental subtropical, 3 maritime subtropical, 4 desert, "
-                  "5 continental temperate, 6 maritime temperate over land, 7 maritime temperate over sea)")
-      ->capture_default_str();
-  cmd->add_option("--time", o->time, "ITM: fraction of time the loss is not exceeded")->capture_default_str();
-  cmd->add_option("--location", o->location, "ITM: fraction of locations")->capture_default_str();
-  cmd->add_option("--situation", o->situation, "ITM: fraction of situations (confidence)")->capture_default_str();
-  cmd->add_option("--mdvar", o->mdvar,
-                  "ITM: variability mode 0..3 (single message, accidental, mobile, broadcast), +10 without location "
-                  "variability, +20 without direct situation variability (SPLAT!: 12)")
-      ->capture_default_str();
   cmd->add_option("--threads", o->threads,
                   "Threads per process (default: the cores, shared among the ranks on a node under mpirun)");
   cmd->add_flag("--force", o->force, "Replace an existing output file");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o, cmd] {
     for (const char* name : kDeygoutOptions)
-      if (cmd->count(name) > 0) o->given.push_back(name);
-    for (const char* name : kItmOptions)
       if (cmd->count(name) > 0) o->given.push_back(name);
     run_rf(*o);
   });

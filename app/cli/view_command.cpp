@@ -1,12 +1,15 @@
 // `terravol view DEM... [--camera LAT,LON,ALT,HEADING,PITCH]`: the interactive viewer
 // (app/viewer/viewer.h) on an X display.
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "app/cli/commands.h"
 #include "app/cli/scene_options.h"
+#include "app/render/terrain_renderer.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
 #include "app/viewer/viewer.h"
@@ -20,6 +23,7 @@ void add_view_command(CLI::App& app) {
     viewer::ViewOptions o;
     std::string camera;
     bool no_slide = false;
+    std::string profile_agl = "30,10";
     SceneArgs scene;
   };
   auto raw = std::make_shared<Raw>();
@@ -45,6 +49,13 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--status", o.status, "After every frame, write the viewer's state to this JSON file");
   cmd->add_option("--screenshot", o.screenshot,
                   "Where key P writes the view (PNG, replaced each time; default terravol-view-NNN.png here)");
+  cmd->add_option("--profile-plot", o.profile_plot,
+                  "Where two Shift-clicks write their link profile's plot (PNG, replaced each time; default "
+                  "terravol-profile-NNN.png here)");
+  cmd->add_option("--profile-agl", raw->profile_agl,
+                  "TX,RX: the profile's antennas, metres above the ground at the first and second click")
+      ->capture_default_str();
+  cmd->add_option("--profile-freq", o.profile_freq_mhz, "The profile's frequency, MHz")->capture_default_str();
   cmd->callback([=] {
     viewer::ViewOptions& opt = raw->o;
     // The scene file first; whatever the command line gave wins.
@@ -61,6 +72,28 @@ void add_view_command(CLI::App& app) {
       throw std::invalid_argument("--speed: must be a positive number");
     }
     if (opt.agl && !opt.pose) throw std::invalid_argument("--agl needs --camera");
+    {
+      char comma = 0, extra = 0;
+      std::istringstream in(raw->profile_agl);
+      in >> opt.profile_tx_agl >> comma >> opt.profile_rx_agl;
+      const bool ok = in && comma == ',' && !(in >> extra);
+      const auto height = [](double h) { return h >= 0.0 && h <= 100000.0; };
+      if (!ok || !height(opt.profile_tx_agl) || !height(opt.profile_rx_agl)) {
+        throw std::invalid_argument("--profile-agl " + raw->profile_agl +
+                                    ": expected TX,RX, metres above ground within [0, 100000]");
+      }
+    }
+    if (!(opt.profile_freq_mhz > 0.0 && opt.profile_freq_mhz <= 100000.0)) {
+      throw std::invalid_argument("--profile-freq: must be within (0, 100000] MHz");
+    }
+    if (!opt.profile_plot.empty()) {
+      const std::filesystem::path folder = opt.profile_plot.parent_path();
+      if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+        throw std::invalid_argument("--profile-plot " + opt.profile_plot.string() + ": folder " + folder.string() +
+                                    " does not exist");
+      }
+    }
+    render::require_x_display("view");
     viewer::run_viewer(opt);
   });
 }

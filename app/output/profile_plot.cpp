@@ -4,8 +4,8 @@
 #include <vtkAxis.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
+#include <vtkContextActor.h>
 #include <vtkContextScene.h>
-#include <vtkContextView.h>
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkPen.h>
@@ -84,7 +84,6 @@ std::vector<std::uint8_t> profile_png(const volume::LinkProfile& l, const std::s
   }
   const volume::PathProfile& p = l.path.profile;
   const volume::FresnelAnalysis& f = l.fresnel;
-  render::require_x_display();
 
   // The samples with both ends; the ends' ground is the DEM under the antennas.
   const std::size_t n = p.d_m.size() + 2;
@@ -107,13 +106,21 @@ std::vector<std::uint8_t> profile_png(const volume::LinkProfile& l, const std::s
     lower60[i] = los[i] - 0.6 * f1;
   }
 
-  vtkNew<vtkContextView> view;
-  vtkRenderWindow* window = view->GetRenderWindow();
+  // A plain render window with the chart's scene on a vtkContextActor, not a vtkContextView:
+  // the view makes a render window interactor, and making or freeing one while `terravol view`
+  // runs its X event loop corrupts the loop's list of interactors (VTK 9.1 crashed there).
+  vtkNew<vtkRenderWindow> window;
+  render::use_shared_display(window, "the profile plot");
   window->SetOffScreenRendering(1);
   window->SetSize(width, height);
-  view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
+  vtkNew<vtkRenderer> renderer;
+  renderer->SetBackground(1.0, 1.0, 1.0);
+  window->AddRenderer(renderer);
+  vtkNew<vtkContextActor> actor;
+  actor->GetScene()->SetRenderer(renderer);
+  renderer->AddActor(actor);
   vtkNew<vtkChartXY> chart;
-  view->GetScene()->AddItem(chart);
+  actor->GetScene()->AddItem(chart);
   chart->SetTitle(title);
   chart->GetTitleProperties()->SetFontSize(13);
   chart->GetTitleProperties()->SetColor(0, 0, 0);

@@ -18,7 +18,8 @@ namespace terravol::app::output {
 //   the line (line of sight - 0.6 F1);
 // - Deygout's knife edges (the model's diffraction edges) and the worst obstruction, as markers;
 // - `title` above the chart (e.g. the verdict).
-// Needs an X display (require_x_display: VTK 9.1 renders through GLX even offscreen).
+// Needs an X display (drawn on the process's one connection, render::use_shared_display: VTK
+// 9.1 renders through GLX even offscreen).
 // Throws std::invalid_argument for a size outside [200, 8000] pixels and std::runtime_error when
 // no display can be opened or encoding fails.
 std::vector<std::uint8_t> profile_png(const volume::LinkProfile& profile, const std::string& title, int width,

@@ -15,6 +15,7 @@
 
 #include "app/scene/ground_grid.h"
 #include "app/scene/mosaic_lattice.h"
+#include "app/scene/profile_path.h"
 #include "app/scene/timing.h"
 #include "io/error.h"
 
@@ -322,6 +323,27 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   sync_vertices(*renderer_);
   if (options_.legend) renderer_->set_legend(volumes_.legend());
   return volumes_.figures();
+}
+
+volume::LinkProfile SceneRenderer::link_profile(const volume::Transmitter& tx, double rx_lat, double rx_lon,
+                                                double rx_height_agl, const volume::RfOptions& options) const {
+  const volume::DemExtent area{std::min(tx.lat, rx_lat), std::max(tx.lat, rx_lat), std::min(tx.lon, rx_lon),
+                               std::max(tx.lon, rx_lon)};
+  volume::RfWindow window;
+  {
+    const std::lock_guard<std::mutex> lock(mosaic_mutex_);
+    window = volume::read_rf_window(mosaic_, area);
+  }
+  return volume::link_profile(window.grid, tx, rx_lat, rx_lon, rx_height_agl, options);
+}
+
+double SceneRenderer::set_path(const volume::Mesh& path) {
+  const auto t0 = Clock::now();
+  const std::uint32_t id = scene::kProfilePathId;
+  const mrbsp::SurfaceInput input{path.vertices, path.colors, path.triangles};
+  scene_->set_surfaces(std::span(&id, 1), std::span(&input, 1));
+  sync_vertices(*renderer_);
+  return ms_since(t0);
 }
 
 std::vector<std::uint8_t> SceneRenderer::rgb() const { return renderer_->rgb(); }

@@ -27,6 +27,7 @@
 #include "app/scene/volume_layer.h"
 #include "io/mosaic.h"
 #include "mrbsp/terrain_tree.h"
+#include "volume/profile.h"
 
 namespace terravol::app::render {
 
@@ -180,6 +181,18 @@ class SceneRenderer {
   // next prepare()).
   scene::ObjectLayer& objects() { return objects_; }
   const scene::ObjectLayer& objects() const { return objects_; }
+
+  // A link profile (volume::link_profile) from tx to a receiver rx_height_agl metres above the
+  // ground at (rx_lat, rx_lon), over the mosaic's samples around the path
+  // (volume::read_rf_window, under the mosaic's lock, so that a slide read ahead may run).
+  // Throws std::invalid_argument for bad parameters or ends off the mosaic, io::FormatError for
+  // tiles that fail to load.
+  volume::LinkProfile link_profile(const volume::Transmitter& tx, double rx_lat, double rx_lon, double rx_height_agl,
+                                   const volume::RfOptions& options = {}) const;
+  // Merges `path` (e.g. scene::profile_path_mesh) into the tree under scene::kProfilePathId,
+  // replacing the one before (an empty mesh removes it; slides merge it again), and uploads
+  // the vertices. Returns the merge's wall milliseconds.
+  double set_path(const volume::Mesh& path);
 
  private:
   // A moved window read from the mosaic (and, read ahead, shaded), ready to slide to.

@@ -87,14 +87,19 @@ Display* shared_display() {
 
 }  // namespace
 
-void require_x_display() {
+void require_x_display(const std::string& who) {
   const char* name = std::getenv("DISPLAY");
   const bool named = name != nullptr && *name != '\0';
   if (!named || shared_display() == nullptr) {
-    throw std::runtime_error("render needs an X display and none can be opened (DISPLAY=" +
+    throw std::runtime_error(who + " needs an X display and none can be opened (DISPLAY=" +
                              std::string(named ? name : "(unset)") +
                              "); run it under xvfb-run -a -s \"-screen 0 1920x1080x24\"");
   }
+}
+
+void use_shared_display(vtkRenderWindow* window, const std::string& who) {
+  require_x_display(who);
+  window->SetDisplayId(shared_display());  // not owned: VTK leaves it open
 }
 
 TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,

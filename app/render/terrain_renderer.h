@@ -74,10 +74,17 @@ vtkSmartPointer<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indi
 // bytes, top row first (what a PNG encoder or a video encoder takes).
 std::vector<std::uint8_t> window_rgb(vtkRenderWindow* window);
 
-// Throws std::runtime_error (one line, naming $DISPLAY and xvfb-run) when no X display can be
-// opened: VTK 9.1 on Debian renders through GLX even offscreen, and aborts without a display.
-// The connection it opens stays open for the process and serves every TerrainRenderer.
-void require_x_display();
+// Throws std::runtime_error (one line: "WHO needs an X display ...", naming $DISPLAY and
+// xvfb-run) when no X display can be opened: VTK 9.1 on Debian renders through GLX even
+// offscreen, and aborts without a display. `who` names what needs it for the user (the
+// command, e.g. "profile -o"). The connection it opens stays open for the process and serves
+// every TerrainRenderer.
+void require_x_display(const std::string& who = "render");
+
+// Puts `window` (any VTK render window, e.g. a vtkContextView's) on that one connection
+// (require_x_display(who) first), so that closing it closes no connection: a window with its
+// own connection inside a running viewer left the viewer's X event loop polling a closed one.
+void use_shared_display(vtkRenderWindow* window, const std::string& who = "render");
 
 class TerrainRenderer {
  public:

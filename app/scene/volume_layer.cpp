@@ -98,7 +98,7 @@ struct VolumeLayer::Loaded {
   GroundGrid ground;
   std::unique_ptr<volume::LatticeMapper> mapper;
   std::vector<volume::Mesh> isosurfaces, slices;
-  volume::Mesh markers;  // its transmitters' masts (empty without markers)
+  volume::Mesh markers;  // its transmitters' masts (shown with markers_shown_)
   // Changed since the last merge_into(), each surface (isosurfaces, slices, then the markers);
   // a change of the volume's visibility changes all of them.
   std::vector<bool> changed;
@@ -128,7 +128,7 @@ VolumeLayer& VolumeLayer::operator=(VolumeLayer&&) noexcept = default;
 
 VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
                          std::size_t max_triangles, bool markers)
-    : max_triangles_(max_triangles) {
+    : max_triangles_(max_triangles), markers_shown_(markers) {
   const auto t0 = Clock::now();
   for (const VolumeSpec& spec : specs) {
     auto v = std::make_unique<Loaded>();
@@ -160,7 +160,7 @@ VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic&
     v->range = finite_range(v->data);
     for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
     for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
-    if (markers) v->markers = marker_mesh(transmitters_of(v->data), frame, v->ground);
+    v->markers = marker_mesh(transmitters_of(v->data), frame, v->ground);
     v->changed.assign(v->isosurfaces.size() + v->slices.size() + 1, true);
     volumes_.push_back(std::move(v));
   }
@@ -192,14 +192,15 @@ void VolumeLayer::merge_into(TerrainScene& scene) {
     const std::size_t isos = l.isosurfaces.size(), surfaces = isos + l.slices.size();
     for (std::size_t k = 0; k < l.changed.size(); ++k) {
       const volume::Mesh& m = k < isos ? l.isosurfaces[k] : k < surfaces ? l.slices[k - isos] : l.markers;
+      const bool shown = l.spec.visible && (k < surfaces || markers_shown_);
       if (l.spec.visible && k < surfaces) figures_.input_triangles += m.triangle_count();
       if (!fresh && !l.changed[k]) continue;
       l.changed[k] = false;
-      if (fresh && (!l.spec.visible || m.empty())) continue;
+      if (fresh && (!shown || m.empty())) continue;
       const std::uint32_t kind = k < isos ? 0 : k < surfaces ? 1 : 2;
       const std::size_t index = k < isos ? k : k < surfaces ? k - isos : 0;
       ids.push_back(static_cast<std::uint32_t>(v << 16 | kind << 14 | index));
-      inputs.push_back(l.spec.visible ? mrbsp::SurfaceInput{m.vertices, m.colors, m.triangles} : mrbsp::SurfaceInput{});
+      inputs.push_back(shown ? mrbsp::SurfaceInput{m.vertices, m.colors, m.triangles} : mrbsp::SurfaceInput{});
     }
   }
   const auto t0 = Clock::now();
@@ -214,6 +215,14 @@ void VolumeLayer::set_visible(std::size_t volume, bool visible) {
   Loaded& v = *volumes_[volume];
   if (v.spec.visible != visible) v.changed.assign(v.changed.size(), true);
   v.spec.visible = visible;
+}
+
+void VolumeLayer::set_markers(bool shown) {
+  if (shown == markers_shown_) return;
+  markers_shown_ = shown;
+  for (const auto& v : volumes_) {
+    if (!v->markers.empty()) v->changed.back() = true;  // the last surface: the markers
+  }
 }
 
 void VolumeLayer::set_slice(std::size_t volume, std::size_t slice, const volume::SliceSpec& s) {

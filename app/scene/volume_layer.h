@@ -68,9 +68,10 @@ class VolumeLayer {
   // Each isosurface is reduced to at most `max_triangles` (volume::reduced_isosurface with the
   // default edge collapse; 0: never), so that an isovalue change fits an interaction. Slices
   // are kept at the volume's resolution (volume::slice), never decimated.
-  // With `markers`, each transmitter the volume records (its "transmitters" attribute, or
+  // Each transmitter the volume records (its "transmitters" attribute, or
   // tx_lat/tx_lon/tx_height_agl_m of a single one) gets an opaque red mast from the ground to
-  // the antenna with a diamond at its top, merged like the surfaces (hidden with its volume).
+  // the antenna with a diamond at its top, merged like the surfaces (hidden with its volume);
+  // `markers` says whether they are shown at the start (set_markers).
   VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic& mosaic, const io::SceneFrame& frame,
               std::size_t max_triangles = kDefaultSurfaceTriangles, bool markers = true);
   ~VolumeLayer();
@@ -95,6 +96,10 @@ class VolumeLayer {
   void set_visible(std::size_t volume, bool visible);
   void set_slice(std::size_t volume, std::size_t slice, const volume::SliceSpec& spec);
   void set_isosurface(std::size_t volume, std::size_t iso, const volume::IsoSpec& spec);
+  // Shows or hides every volume's transmitter markers: only the marker surfaces change (the
+  // next merge_into() removes or merges them alone).
+  void set_markers(bool shown);
+  bool markers_shown() const { return markers_shown_; }
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
   // slice's range, and every isosurface level with its colour; for a "categorical" slice no
@@ -114,6 +119,7 @@ class VolumeLayer {
   MergeFigures figures_;
   const void* merged_tree_ = nullptr;  // the tree merge_into() last brought up to date
   std::size_t max_triangles_ = kDefaultSurfaceTriangles;
+  bool markers_shown_ = true;
 };
 
 }  // namespace terravol::app::scene

@@ -1,6 +1,7 @@
 #include "app/viewer/overlay_layout.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace terravol::app::viewer {
 
@@ -16,19 +17,32 @@ Box united(const Box& a, const Box& b) {
   return {x, y, std::max(a.right(), b.right()) - x, std::max(a.bottom(), b.bottom()) - y};
 }
 
-namespace {
-
-// The largest font in [smallest, largest] whose text fits w x h; 0 when none does.
 int fitting_font(const std::function<std::array<int, 2>(int)>& measure, int largest, int smallest, int w, int h,
                  std::array<int, 2>& size) {
-  for (int f = largest; f >= smallest; --f) {
-    size = measure(f);
-    if (size[0] <= w && size[1] <= h) return f;
+  const auto fits = [&](const std::array<int, 2>& s) { return s[0] <= w && s[1] <= h; };
+  size = measure(largest);
+  if (fits(size)) return largest;
+  if (size[0] <= 0 || size[1] <= 0 || w <= 0 || h <= 0) return 0;
+  // Text grows about in proportion to the font: start where that says it fits, then step up
+  // while the next size fits too, or down until one does.
+  const double scale = std::min(static_cast<double>(w) / size[0], static_cast<double>(h) / size[1]);
+  int f = std::clamp(static_cast<int>(std::floor(largest * scale)), smallest, largest - 1);
+  size = measure(f);
+  if (fits(size)) {
+    while (f + 1 < largest) {
+      const std::array<int, 2> next = measure(f + 1);
+      if (!fits(next)) break;
+      ++f;
+      size = next;
+    }
+    return f;
+  }
+  while (f > smallest) {
+    size = measure(--f);
+    if (fits(size)) return f;
   }
   return 0;
 }
-
-}  // namespace
 
 OverlayLayout lay_out_overlay(const OverlayInput& in) {
   constexpr int m = kOverlayMargin;

@@ -50,6 +50,15 @@ struct OverlayLayout {
 constexpr int kTextFonts[2] = {15, 8};  // the overlay text's largest and smallest font sizes
 constexpr int kKeyFonts[2] = {14, 7};   // the key list's
 
+// The largest font in [smallest, largest] at which measure(font) fits w x h (size: that
+// measure), or 0 when none does. The measure must grow with the font (each is some
+// milliseconds of FreeType layout in the viewer, so not every size is tried): after the largest,
+// the size that the largest's overshoot says fits, then one step at a time up or down from it;
+// at most 4 measures (of the 8 sizes the viewer tries) when the text's size is proportional to
+// the font, as the rounding of whole pixels allows.
+int fitting_font(const std::function<std::array<int, 2>(int)>& measure, int largest, int smallest, int w, int h,
+                 std::array<int, 2>& size);
+
 // The layout: the slider's panel kOverlayMargin from the lower right corner; the legend above
 // it against the right edge (at most the height left above the slider); the text in the upper
 // left, left of the legend and above the slider; the key list in the lower left, left of the

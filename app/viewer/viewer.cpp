@@ -48,11 +48,13 @@
 #include <utility>
 
 #include "app/output/png_output.h"
+#include "app/output/profile_plot.h"
 #include "app/output/write_file.h"
 #include "app/render/scene_renderer.h"
 #include "app/render/terrain_renderer.h"
 #include "app/scene/camera_path.h"
 #include "app/scene/mosaic_lattice.h"
+#include "app/scene/profile_path.h"
 #include "app/scene/terrain_scene.h"
 #include "app/scene/timing.h"
 #include "app/scene/volume_layer.h"
@@ -68,6 +70,7 @@ const char* const kViewKeys =
     "arrows       turn left / right, look up / down\n"
     "left drag    look around\n"
     "Ctrl+click   the point under the cursor: lat, lon, ground, each volume's value\n"
+    "Shift+click  twice: the link profile between the two points, drawn and plotted\n"
     "Shift        4x faster; mouse wheel: speed x1.25 or /1.25\n"
     "+ / -        finer / coarser LOD (threshold / or x sqrt 2); or drag the slider\n"
     "M            LOD metric: screen-space error / projected area\n"
@@ -75,6 +78,7 @@ const char* const kViewKeys =
     "T            wireframe (triangle edges)\n"
     "G            automatic sliding of the window\n"
     "1 .. 9       show or hide volume N (and select it)\n"
+    "X            transmitter markers on / off\n"
     "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
     ", / .        lower / raise its first isosurface's level by 2 units\n"
     "P            screenshot (PNG)\n"
@@ -189,6 +193,17 @@ ordered_json box_json(const Box& b) {
 
 constexpr auto kOverlayPeriod = std::chrono::milliseconds(250);
 
+// `given`, or when it is empty the first STEM-NNN.png (NNN from 001) not in the current folder.
+std::filesystem::path given_or_next_free(const std::filesystem::path& given, const char* stem) {
+  std::filesystem::path path = given;
+  for (int k = 1; path.empty() || (given.empty() && std::filesystem::exists(path)); ++k) {
+    char name[96];
+    std::snprintf(name, sizeof name, "%s-%03d.png", stem, k);
+    path = name;
+  }
+  return path;
+}
+
 class ViewerStyle;
 
 class Viewer {
@@ -205,6 +220,7 @@ class Viewer {
   void key_release(const std::string& key);
   void button(bool down, int x, int y);
   void pick(int x, int y);
+  void profile_pick(int x, int y);
   void mouse_move(int x, int y);
   void wheel(int clicks);
   void leave();
@@ -228,6 +244,8 @@ class Viewer {
   bool held(const char* key) const { return held_.count(key) > 0 || tapped_.count(key) > 0; }
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void volume_key(const std::string& key);
+  void markers_key();
+  void write_profile(const io::Geodetic& from, const io::Geodetic& to);
   void record_key();
   void save_path();
 
@@ -251,12 +269,18 @@ class Viewer {
   // Figures.
   std::size_t frames_ = 0, screenshots_ = 0, key_presses_ = 0;
   double frame_ms_ = 0, traversal_ms_ = 0, upload_ms_ = 0, draw_ms_ = 0;
+  double overlay_ms_ = 0;  // of the frame: the overlay's text and its layout (update_overlay, lay_out)
   std::vector<double> frame_log_, traversal_log_, draw_log_, slide_log_;  // slide_log_: this thread's part
   std::filesystem::path last_screenshot_;
   std::string message_;  // shown in the overlay (e.g. where a screenshot went)
   std::optional<render::Pick> pick_;  // the last Ctrl-click's point (status file)
+  Clock::time_point pick_time_;          // when it was handled
+  std::optional<double> pick_shown_ms_;  // from then to the end of the draw that first showed it
+  std::optional<io::Geodetic> profile_from_;  // the first Shift-click's point, until the second
+  nlohmann::ordered_json profile_status_;     // the last profile path (status file); null: none
   std::string overlay_settings_;  // the overlay's settings lines as last drawn
   bool layout_dirty_ = true;  // the text, the key list or the legend changed since lay_out()
+  bool slider_dirty_ = true;  // the slider's texts changed since lay_out() placed them
   int layout_size_[2] = {0, 0};
   OverlayLayout layout_;
   double knob_lo_ = 0, knob_hi_ = 0;  // the knob's centre at the range's ends, window pixels
@@ -293,6 +317,8 @@ class ViewerStyle : public vtkInteractorStyle {
   void OnLeftButtonDown() override {
     if (this->Interactor->GetControlKey() != 0) {
       viewer_->pick(pos()[0], pos()[1]);
+    } else if (this->Interactor->GetShiftKey() != 0) {
+      viewer_->profile_pick(pos()[0], pos()[1]);
     } else {
       viewer_->button(true, pos()[0], pos()[1]);
     }
@@ -502,6 +528,8 @@ void Viewer::key_press(const std::string& key) {
     set_metric(metric_ == mrbsp::LodMetric::kError ? mrbsp::LodMetric::kArea : mrbsp::LodMetric::kError);
   } else if (key == "g") {
     pipeline_->set_auto_slide(!pipeline_->auto_slide());
+  } else if (key == "x") {
+    markers_key();
   } else if (key == "p") {
     screenshot_pending_ = true;
   } else if (key == "k") {
@@ -539,6 +567,8 @@ void Viewer::button(bool down, int x, int y) {
 
 // The point under the cursor, in the overlay: where, the ground, and each visible volume's value.
 void Viewer::pick(int x, int y) {
+  pick_time_ = Clock::now();
+  pick_shown_ms_.reset();
   pick_ = pipeline_->pick(x, y);
   dirty_ = true;
   if (!pick_) {
@@ -554,6 +584,93 @@ void Viewer::pick(int x, int y) {
     std::snprintf(b, sizeof b, "\n  %s: %.2f %s", v.volume.c_str(), v.value, v.units.c_str());
     message_ += b;
   }
+}
+
+// Two Shift-clicks: the first end, then the second, and the link profile between them drawn
+// over the terrain and plotted (write_profile). A third starts a new path.
+void Viewer::profile_pick(int x, int y) {
+  dirty_ = true;
+  const std::optional<render::Pick> p = pipeline_->pick(x, y);
+  if (!p) {
+    message_ = "profile: nothing under the cursor (sky, or beyond the window)";
+    return;
+  }
+  const io::Geodetic at{p->point.where.lat, p->point.where.lon, p->ground};
+  if (!profile_from_) {
+    profile_from_ = at;
+    char b[160];
+    std::snprintf(b, sizeof b, "profile from %.5f, %.5f: Shift+click its other end", at.lat, at.lon);
+    message_ = b;
+    profile_status_ = {{"from", {{"lat", at.lat}, {"lon", at.lon}, {"ground", at.h}}}, {"to", nullptr}};
+    return;
+  }
+  const io::Geodetic from = *std::exchange(profile_from_, std::nullopt);
+  write_profile(from, at);
+}
+
+// The link from an antenna above `from` to one above `to` (ViewOptions' heights and
+// frequency), as terravol profile computes it (volume::link_profile over the mosaic's samples),
+// its path merged into the tree (scene::profile_path_mesh) and its plot written atomically.
+void Viewer::write_profile(const io::Geodetic& from, const io::Geodetic& to) {
+  const auto t0 = Clock::now();
+  volume::Transmitter tx;
+  tx.lat = from.lat;
+  tx.lon = from.lon;
+  tx.height_agl = o_.profile_tx_agl;
+  tx.frequency_mhz = o_.profile_freq_mhz;
+  const std::filesystem::path path = given_or_next_free(o_.profile_plot, "terravol-profile");
+  try {
+    const volume::LinkProfile l = pipeline_->link_profile(tx, to.lat, to.lon, o_.profile_rx_agl);
+    const double profile_ms = ms_since(t0);
+    const render::SceneRenderer& pipeline = *pipeline_;
+    const volume::Mesh wall = scene::profile_path_mesh(
+        l, from.lat, from.lon, to.lat, to.lon, pipeline.frame(),
+        [&pipeline](double lat, double lon) { return pipeline.ground_height(lat, lon); });
+    const double merge_ms = pipeline_->set_path(wall);
+    const std::string verdict = volume::verdict(l);
+    const auto t1 = Clock::now();
+    output::write_png(path, output::profile_png(l, verdict, 1200, 600), true);
+    const double plot_ms = ms_since(t1);
+    const volume::FresnelAnalysis& f = l.fresnel;
+    profile_status_ = {{"from", {{"lat", from.lat}, {"lon", from.lon}, {"ground", from.h}}},
+                       {"to", {{"lat", to.lat}, {"lon", to.lon}, {"ground", to.h}}},
+                       {"tx_agl", o_.profile_tx_agl},
+                       {"rx_agl", o_.profile_rx_agl},
+                       {"freq_mhz", o_.profile_freq_mhz},
+                       {"distance_km", l.path.profile.distance_m / 1000.0},
+                       {"path_loss_db", l.path.path_loss_db},
+                       {"worst_clearance_m", f.worst < f.clearance_m.size() ? ordered_json(f.worst_clearance_m) : ordered_json(nullptr)},
+                       {"worst_clearance_f1", f.worst < f.clearance_m.size() ? ordered_json(f.worst_clearance_f1) : ordered_json(nullptr)},
+                       {"verdict", verdict},
+                       {"file", path.string()},
+                       {"path_triangles", wall.triangle_count()},
+                       {"tree_pieces", pipeline_->terrain().tree().merge_stats().stored_polygons},
+                       {"profile_ms", profile_ms},
+                       {"merge_ms", merge_ms},
+                       {"plot_ms", plot_ms}};
+    std::string shown = verdict;
+    if (const std::size_t at = shown.find("; path loss"); at != std::string::npos) shown.replace(at, 2, "\n  ");
+    char b[160];
+    std::snprintf(b, sizeof b, "profile %.2f km (%.0f ms): ", l.path.profile.distance_m / 1000.0, ms_since(t0));
+    message_ = b + shown + "\n  wrote " + path.string();
+  } catch (const std::exception& e) {
+    message_ = std::string("profile failed: ") + e.what();
+    profile_status_ = {{"error", e.what()}};
+    std::fprintf(stderr, "terravol: %s\n", message_.c_str());
+  }
+}
+
+// X: every volume's transmitter markers on or off; only their surfaces are merged again.
+void Viewer::markers_key() {
+  scene::VolumeLayer& volumes = pipeline_->volumes();
+  const auto t0 = Clock::now();
+  volumes.set_markers(!volumes.markers_shown());
+  const scene::MergeFigures& merge = pipeline_->remerge();
+  last_merge_ms_ = ms_since(t0);
+  char b[128];
+  std::snprintf(b, sizeof b, "transmitter markers %s: %.0f ms (%zu surfaces merged)", volumes.markers_shown() ? "on" : "off",
+                last_merge_ms_, merge.merged_surfaces);
+  message_ = b;
 }
 
 void Viewer::mouse_move(int x, int y) {
@@ -739,7 +856,7 @@ void Viewer::sync_slider() {
   slider_title_->SetInput(title.c_str());
   slider_min_->SetInput(error ? "0.25 px  finer" : "32 px^2  finer");
   slider_max_->SetInput(error ? "coarser  16 px" : "coarser  32768 px^2");
-  layout_dirty_ = true;  // the title's width changed
+  layout_dirty_ = slider_dirty_ = true;  // the title's width changed
 }
 
 void Viewer::draw_frame() {
@@ -759,10 +876,13 @@ void Viewer::draw_frame() {
   const double speed = scene::flight_speed(agl, flight_, held("Shift_L") || held("Shift_R"));
   traversal_ms_ = f.traversal_ms;
   upload_ms_ = f.upload_ms;
+  const auto overlay_t0 = Clock::now();
   update_overlay(agl, speed);
   lay_out();
+  overlay_ms_ = ms_since(overlay_t0);
   draw_ms_ = pipeline_->draw();
   frame_ms_ = ms_since(t0);
+  if (pick_ && !pick_shown_ms_) pick_shown_ms_ = ms_since(pick_time_);
   if (frames_ > 0) {  // the first frame compiles shaders and uploads every vertex
     frame_log_.push_back(frame_ms_);
     traversal_log_.push_back(traversal_ms_);
@@ -815,7 +935,8 @@ void Viewer::lay_out() {
   vtkRenderWindow* win = pipeline_->renderer().window();
   const int* size = win->GetSize();
   const int W = size[0], H = size[1];
-  if (!layout_dirty_ && W == layout_size_[0] && H == layout_size_[1]) return;
+  const bool resized = W != layout_size_[0] || H != layout_size_[1];
+  if (!layout_dirty_ && !resized) return;
   layout_dirty_ = false;
   layout_size_[0] = W;
   layout_size_[1] = H;
@@ -844,48 +965,53 @@ void Viewer::lay_out() {
   layout_ = lay_out_overlay(in);
 
   // The slider: the panel, the title at its top, the tube across its middle, the end labels
-  // at its bottom.
-  const Box& sb = layout_.slider;
-  const double nx0 = double(sb.x) / W, nx1 = double(sb.right()) / W;
-  const double ny0 = 1.0 - double(sb.bottom()) / H, ny1 = 1.0 - double(sb.y) / H;
-  slider_corners_->SetPoint(0, nx0, ny0, 0.0);
-  slider_corners_->SetPoint(1, nx1, ny0, 0.0);
-  slider_corners_->SetPoint(2, nx1, ny1, 0.0);
-  slider_corners_->SetPoint(3, nx0, ny1, 0.0);
-  slider_corners_->Modified();
-  const double tube_y = H - (sb.y + kSliderTubeY);
-  slider_rep_->GetPoint1Coordinate()->SetValue(sb.x + kSliderInset, tube_y);
-  slider_rep_->GetPoint2Coordinate()->SetValue(sb.right() - kSliderInset, tube_y);
-  // VTK sizes the slider's parts as fractions of the window: lengths of its width, widths of
-  // its height (9.1), so that these are pixels.
-  slider_rep_->SetEndCapLength(8.0 / W);
-  slider_rep_->SetSliderLength(14.0 / W);
-  slider_rep_->SetSliderWidth(28.0 / H);
-  slider_rep_->SetTubeWidth(8.0 / H);
-  slider_rep_->SetEndCapWidth(22.0 / H);
-  // The title and the end labels at the largest size that fits the panel's width.
-  const int inner = sb.w - 2 * kSliderPad;
-  int title_font = 16;
-  while (title_font > 7 && measure(slider_title_)(title_font)[0] > inner) --title_font;
-  slider_title_->GetTextProperty()->SetFontSize(title_font);
-  int end_font = 13;
-  while (end_font > 6 && measure(slider_min_)(end_font)[0] + measure(slider_max_)(end_font)[0] + 12 > inner) --end_font;
-  slider_min_->GetTextProperty()->SetFontSize(end_font);
-  slider_max_->GetTextProperty()->SetFontSize(end_font);
-  slider_title_->SetPosition(sb.x + kSliderPad, H - (sb.y + kSliderPad));
-  slider_min_->SetPosition(sb.x + kSliderPad, H - (sb.bottom() - kSliderPad));
-  slider_max_->SetPosition(sb.right() - kSliderPad, H - (sb.bottom() - kSliderPad));
-  const double value = slider_rep_->GetValue();
-  slider_rep_->SetValue(slider_rep_->GetMinimumValue());
-  const auto knob_x = [&] {
-    const Box k = slider_rep_->knob_box(H);
-    return k.x + 0.5 * k.w;
-  };
-  knob_lo_ = knob_x();
-  slider_rep_->SetValue(slider_rep_->GetMaximumValue());
-  knob_hi_ = knob_x();
-  slider_rep_->SetValue(value);
-  slider_rep_->BuildRepresentation();
+  // at its bottom; placed again only when the window's size or its texts changed (its box
+  // depends on nothing else), since measuring its texts and building its representation cost
+  // milliseconds that a changed overlay message need not pay.
+  if (resized || slider_dirty_) {
+    slider_dirty_ = false;
+    const Box& sb = layout_.slider;
+    const double nx0 = double(sb.x) / W, nx1 = double(sb.right()) / W;
+    const double ny0 = 1.0 - double(sb.bottom()) / H, ny1 = 1.0 - double(sb.y) / H;
+    slider_corners_->SetPoint(0, nx0, ny0, 0.0);
+    slider_corners_->SetPoint(1, nx1, ny0, 0.0);
+    slider_corners_->SetPoint(2, nx1, ny1, 0.0);
+    slider_corners_->SetPoint(3, nx0, ny1, 0.0);
+    slider_corners_->Modified();
+    const double tube_y = H - (sb.y + kSliderTubeY);
+    slider_rep_->GetPoint1Coordinate()->SetValue(sb.x + kSliderInset, tube_y);
+    slider_rep_->GetPoint2Coordinate()->SetValue(sb.right() - kSliderInset, tube_y);
+    // VTK sizes the slider's parts as fractions of the window: lengths of its width, widths of
+    // its height (9.1), so that these are pixels.
+    slider_rep_->SetEndCapLength(8.0 / W);
+    slider_rep_->SetSliderLength(14.0 / W);
+    slider_rep_->SetSliderWidth(28.0 / H);
+    slider_rep_->SetTubeWidth(8.0 / H);
+    slider_rep_->SetEndCapWidth(22.0 / H);
+    // The title and the end labels at the largest size that fits the panel's width.
+    const int inner = sb.w - 2 * kSliderPad;
+    int title_font = 16;
+    while (title_font > 7 && measure(slider_title_)(title_font)[0] > inner) --title_font;
+    slider_title_->GetTextProperty()->SetFontSize(title_font);
+    int end_font = 13;
+    while (end_font > 6 && measure(slider_min_)(end_font)[0] + measure(slider_max_)(end_font)[0] + 12 > inner) --end_font;
+    slider_min_->GetTextProperty()->SetFontSize(end_font);
+    slider_max_->GetTextProperty()->SetFontSize(end_font);
+    slider_title_->SetPosition(sb.x + kSliderPad, H - (sb.y + kSliderPad));
+    slider_min_->SetPosition(sb.x + kSliderPad, H - (sb.bottom() - kSliderPad));
+    slider_max_->SetPosition(sb.right() - kSliderPad, H - (sb.bottom() - kSliderPad));
+    const double value = slider_rep_->GetValue();
+    slider_rep_->SetValue(slider_rep_->GetMinimumValue());
+    const auto knob_x = [&] {
+      const Box k = slider_rep_->knob_box(H);
+      return k.x + 0.5 * k.w;
+    };
+    knob_lo_ = knob_x();
+    slider_rep_->SetValue(slider_rep_->GetMaximumValue());
+    knob_hi_ = knob_x();
+    slider_rep_->SetValue(value);
+    slider_rep_->BuildRepresentation();
+  }
 
   // The legend, the text and the key list.
   const bool legend = !layout_.legend.empty();
@@ -899,14 +1025,7 @@ void Viewer::lay_out() {
 }
 
 void Viewer::save_screenshot() {
-  std::filesystem::path path = o_.screenshot;
-  if (path.empty()) {
-    for (int k = 1; path.empty() || std::filesystem::exists(path); ++k) {
-      char name[64];
-      std::snprintf(name, sizeof name, "terravol-view-%03d.png", k);
-      path = name;
-    }
-  }
+  const std::filesystem::path path = given_or_next_free(o_.screenshot, "terravol-view");
   try {
     output::write_png(path, output::window_png(pipeline_->renderer().window()), true);
     ++screenshots_;
@@ -952,6 +1071,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["traversal_ms"] = traversal_ms_;
   j["upload_ms"] = upload_ms_;
   j["draw_ms"] = draw_ms_;
+  j["overlay_ms"] = overlay_ms_;
   j["slides"] = pipeline_->slides();
   j["last_slide_ms"] = slide.tree_ms + slide.vertices_ms;  // this thread's part
   j["last_slide_parts_ms"] = {{"read_window", slide.read_ms},
@@ -977,7 +1097,9 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                 {"tree_triangles", merge.tree_triangles},
                 {"surface_triangles", o_.style.surface_triangles},
                 {"geometry_ms", merge.geometry_ms},
-                {"merge_ms", merge.merge_ms}};
+                {"merge_ms", merge.merge_ms},
+                {"merged_surfaces", merge.merged_surfaces}};
+  j["markers"] = volumes.markers_shown();
   j["last_merge_ms"] = last_merge_ms_;
   j["message"] = message_;
   if (pick_) {
@@ -988,8 +1110,10 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
     }
     j["pick"] = {{"lat", g.lat},       {"lon", g.lon},       {"height", g.h},
                  {"ground", pick_->ground}, {"on_surface", pick_->point.on_surface}, {"ms", pick_->ms},
+                 {"to_overlay_ms", pick_shown_ms_ ? ordered_json(*pick_shown_ms_) : ordered_json(nullptr)},
                  {"values", values}};
   }
+  if (!profile_status_.is_null()) j["profile"] = profile_status_;
   // Nothing will draw another frame until something happens: no key held, no slide read
   // ahead, no overlay refresh or screenshot due.
   j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_;

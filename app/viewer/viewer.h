@@ -41,6 +41,13 @@ struct ViewOptions {
   // Where the screenshot key writes (replaced each time, atomically); empty: the next free
   // terravol-view-NNN.png in the current folder.
   std::filesystem::path screenshot;
+  // The profile path (two Shift-clicks): its plot (terravol profile's, PNG, atomically, replaced
+  // each time); empty: the next free terravol-profile-NNN.png in the current folder. The link
+  // goes from an antenna profile_tx_agl metres above the first point to one profile_rx_agl
+  // above the second, at profile_freq_mhz, through the built-in model (Deygout, k = 4/3).
+  std::filesystem::path profile_plot;
+  double profile_tx_agl = 30.0, profile_rx_agl = 10.0;  // [0, 100000] m
+  double profile_freq_mhz = 900.0;                      // (0, 100000]
 };
 
 // The key bindings, one per line, for --help and the overlay's help panel.

@@ -113,28 +113,65 @@ TEST(ProfileCli, RidgeClearanceAgreesWithTheHandComputedKnifeEdge) {
   EXPECT_GT(test::color_share(img, {255, 255, 255}, 2), 0.3);
 }
 
-TEST(ProfileCli, PathLossEqualsRfAtTheSameLatticePoints) {
+// `terravol profile MODEL` against `terravol rf MODEL` (queried with `terravol query`) at the
+// same lattice points: the largest difference, in dB.
+double worst_difference_from_rf(const std::string& model, const std::string& heights) {
   test::TempDir dir;
   const auto vdb = dir.path() / "rf.vdb";
   // A 0.01-degree lattice, so that its points have short decimal coordinates.
-  ASSERT_EQ(run_terravol("rf --tx 45.5,6.5,30 --dem " + bundled_dem() + " --radius-km 6 --spacing 36 --heights 10:210:100 -o " +
-                         vdb.string()).status,
-            0);
-  const char* points[] = {"45.54,6.57,10", "45.47,6.43,110", "45.45,6.55,210", "45.53,6.44,10", "45.5,6.56,110"};
+  const auto rf = run_terravol("rf " + model + " --tx 45.5,6.5,30 --dem " + bundled_dem() +
+                               " --radius-km 6 --spacing 36 --heights " + heights + " -o " + vdb.string());
+  EXPECT_EQ(rf.status, 0) << rf.err;
+  const char* points[] = {"45.54,6.57,", "45.47,6.43,", "45.45,6.55,", "45.53,6.44,", "45.5,6.56,"};
+  const std::vector<std::string> agl = {"10", "110", "210", "10", "110"};
   double worst = 0.0;
-  for (const char* to : points) {
-    SCOPED_TRACE(to);
-    const auto p = run_terravol("profile --from 45.5,6.5,30 --to " + std::string(to) + " --dem " + bundled_dem() +
+  for (std::size_t k = 0; k < std::size(points); ++k) {
+    const std::string to = points[k] + agl[k];
+    SCOPED_TRACE(model + " to " + to);
+    const auto p = run_terravol("profile " + model + " --from 45.5,6.5,30 --to " + to + " --dem " + bundled_dem() +
                                 " --csv " + (dir.path() / "x.csv").string() + " --force");
-    ASSERT_EQ(p.status, 0) << p.err;
+    EXPECT_EQ(p.status, 0) << p.err;
     const double profile_loss = after(p.out, "  path loss ");
     const auto q = run_terravol("query --volume " + vdb.string() + " --dem " + bundled_dem() + " --at " + to);
-    ASSERT_EQ(q.status, 0) << q.err;
+    EXPECT_EQ(q.status, 0) << q.err;
     const double rf_loss = std::strtod(q.out.substr(q.out.rfind(',') + 1).c_str(), nullptr);
+    EXPECT_TRUE(std::isfinite(profile_loss) && std::isfinite(rf_loss)) << p.out << q.out;
     EXPECT_NEAR(profile_loss, rf_loss, 0.01);  // the target (printed to 0.001 dB)
     worst = std::max(worst, std::abs(profile_loss - rf_loss));
   }
-  std::printf("profile against rf: largest difference %.4f dB over 5 lattice points\n", worst);
+  return worst;
+}
+
+TEST(ProfileCli, PathLossEqualsRfAtTheSameLatticePoints) {
+  const double worst = worst_difference_from_rf("", "10:210:100");
+  std::printf("profile against rf (Deygout): largest difference %.4f dB over 5 lattice points\n", worst);
+}
+
+TEST(ProfileCli, ItmPathLossEqualsRfWithItmAtTheSameLatticePoints) {
+  const double worst = worst_difference_from_rf("--model itm", "10:210:100");
+  std::printf("profile against rf (ITM): largest difference %.4f dB over 5 lattice points\n", worst);
+}
+
+// The ITM profile says which model gave its loss: no knife edges, the loss beyond free space.
+TEST(ProfileCli, ItmProfileNamesItsModelInTheVerdict) {
+  test::TempDir dir;
+  const auto r = run_terravol("profile --model itm --from 45.5,6.5,30 --to 45.54,6.57,10 --dem " + bundled_dem() +
+                              " --csv " + (dir.path() / "x.csv").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("dB + ITM beyond free space "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" dB beyond free space)\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("knife edge at"), std::string::npos) << r.out;
+}
+
+// Without a display, -o (the plot) fails at once naming the command; the CSV alone needs none.
+TEST(ProfileCli, APlotWithoutAnXDisplayFailsNamingProfile) {
+  test::TempDir dir;
+  const std::string args = "profile --from 45.5,6.5,30 --to 45.54,6.57,10 --dem " + bundled_dem();
+  const auto r = test::run_terravol_under("env -u DISPLAY", args + " -o " + (dir.path() / "p.png").string());
+  expect_one_line_error(r, "profile -o needs an X display");
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+  const auto csv = test::run_terravol_under("env -u DISPLAY", args + " --csv " + (dir.path() / "p.csv").string());
+  EXPECT_EQ(csv.status, 0) << csv.err;
 }
 
 TEST(ProfileCli, BadInputFailsWithOneLineAndWritesNothing) {
@@ -154,6 +191,14 @@ TEST(ProfileCli, BadInputFailsWithOneLineAndWritesNothing) {
       {"--from 45.5,6.5,30 --to 45.5,6.6,10" + dem, "give -o PROFILE.png, --csv PROFILE.csv or both"},
       {"--from 45.5,6.5,30 --to 45.5,6.6,10" + dem + " --csv " + (dir.path() / "x.txt").string(), "--csv "},
       {"--from 45.5,6.5,30 --to 45.5,6.6,10" + dem + csv + " --size 10x10", "--size 10x10"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --model foo" + dem + csv, "--model foo: must be itm or deygout"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --climate 5" + dem + csv, "--climate: only with --model itm"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --model itm --edge-depth 3" + dem + csv, "--edge-depth: only with --model deygout"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --model itm --freq 10" + dem + csv,
+       "--freq 10: ITM takes frequencies within [20, 20000] MHz"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,0.2 --model itm" + dem + csv,
+       "--to 45.5,6.6,0.2: ITM takes antenna heights within [0.5, 3000] m above ground"},
+      {"--from 45.5,6.5,30 --to 45.5,6.6,10 --model itm --time 1.5" + dem + csv, "--time 1.5: must be within (0, 1)"},
   };
   for (const auto& [args, prefix] : cases) {
     SCOPED_TRACE(args);

@@ -98,6 +98,41 @@ TEST(OverlayLayout, RandomWindowsAndTextsNeverOverlapOrLeaveTheWindow) {
   }
 }
 
+// The font search against trying every size from the largest down: the same font for seeded
+// random texts (proportional, and with a few pixels of padding and rounding that are not) and
+// rooms, in at most 4 measures for proportional text (8 sizes to try).
+TEST(OverlayLayout, FontSearchFindsWhatTryingEverySizeFindsInAFewMeasures) {
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 5000; ++trial) {
+    const int chars = std::uniform_int_distribution<int>(1, 140)(rng), lines = std::uniform_int_distribution<int>(1, 30)(rng);
+    const int pad = trial % 2 == 0 ? 0 : std::uniform_int_distribution<int>(1, 6)(rng);
+    const auto text = [&](int font) {
+      return std::array<int, 2>{(chars * font * 6 + 5) / 10 + pad, lines * font * 12 / 10 + pad};
+    };
+    const int w = std::uniform_int_distribution<int>(0, 1500)(rng), h = std::uniform_int_distribution<int>(0, 900)(rng);
+    int every = 0;
+    for (int f = 15; f >= 8 && every == 0; --f) {
+      const auto s = text(f);
+      if (s[0] <= w && s[1] <= h) every = f;
+    }
+    int calls = 0;
+    std::array<int, 2> size{0, 0};
+    const int found = fitting_font(
+        [&](int f) {
+          ++calls;
+          return text(f);
+        },
+        15, 8, w, h, size);
+    ASSERT_EQ(found, every) << "trial " << trial << ": " << chars << " x " << lines << " in " << w << " x " << h;
+    if (found > 0) {
+      EXPECT_EQ(size, text(found)) << "trial " << trial;
+    }
+    if (pad == 0) {
+      EXPECT_LE(calls, 4) << "trial " << trial;
+    }
+  }
+}
+
 TEST(OverlayLayout, OverlapAndUnitedAreOnAreaNotEdges) {
   EXPECT_FALSE(overlap({0, 0, 10, 10}, {10, 0, 5, 5})) << "touching along an edge";
   EXPECT_TRUE(overlap({0, 0, 10, 10}, {9, 9, 5, 5}));

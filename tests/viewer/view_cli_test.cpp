@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <iterator>
 #include <set>
 #include <sstream>
@@ -656,14 +657,128 @@ TEST(ViewCli, CtrlClickPicksTheTerrainOrTheSliceInFrontAndShowsTheVolumesValue) 
     EXPECT_NEAR(p["values"][0]["value"].get<double>(), expected, 1e-3) << p << "\n" << q.out;
     // What the pick costs, and the frame that shows it in the overlay (for docs/rf-model.md).
     const json shown = v.settle();
-    std::printf("pick on the %s: %.2f ms, then the frame %.1f ms\n", with_slice ? "slice" : "terrain", p["ms"].get<double>(),
-                shown["frame_ms"].get<double>());
+    // From the click's handling to the end of the draw of the first frame that shows it.
+    const double to_overlay = shown["pick"]["to_overlay_ms"].get<double>();
+    EXPECT_GE(to_overlay, p["ms"].get<double>());
+    std::printf("pick on the %s: %.2f ms, then the frame %.1f ms (overlay %.1f, draw %.1f); pick to overlay %.1f ms\n",
+                with_slice ? "slice" : "terrain", p["ms"].get<double>(), shown["frame_ms"].get<double>(),
+                shown["overlay_ms"].get<double>(), shown["draw_ms"].get<double>(), to_overlay);
     const std::string message = shown["message"].get<std::string>();
     EXPECT_EQ(message.rfind("pick ", 0), 0u) << message;
     EXPECT_NE(message.find("rf.vdb path_loss_db: "), std::string::npos) << message;
     v.xdo("key q");
     EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
   }
+}
+
+// Pixels of a screenshot near any of `colors` (tolerance per channel).
+std::size_t pixels_near(const test::Image& img, std::initializer_list<test::Rgb8> colors, int tolerance) {
+  std::size_t n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (const auto& c : colors) {
+        if (test::same_color(img.at(x, y), c, tolerance)) {
+          ++n;
+          break;
+        }
+      }
+  return n;
+}
+
+// X hides the transmitter's red mast and shows it again, re-merging the marker surface alone.
+TEST(ViewCli, XTogglesTheTransmitterMarkersMergingOnlyTheirSurface) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  ASSERT_TRUE(make_volume(vdb));
+  // The volume's transmitter (45.5 N, 6.5 E) from 3 km south-west, 400 m up (as the render
+  // test's markers); an isosurface too, which the toggle must leave alone.
+  Viewer v(bundled_dem() + " --agl --camera 45.47,6.47,400,45,-8 --volume " + vdb.string() + " --iso 150" + kSmall);
+  ASSERT_TRUE(v.start());
+  const auto red = [](const test::Image& img) {
+    std::size_t n = 0;
+    for (const auto& p : img.pixels) n += p[0] > 180 && p[1] < 80 && p[2] < 90;
+    return n;
+  };
+  json s = v.settle();
+  EXPECT_TRUE(s["markers"].get<bool>());
+  const std::size_t shown = red(v.screenshot());
+  EXPECT_GT(shown, 20u) << "a mast and its diamond";
+  v.tap("x");
+  s = v.settle();
+  EXPECT_FALSE(s["markers"].get<bool>());
+  EXPECT_EQ(s["merge"]["merged_surfaces"].get<int>(), 1) << "the marker surface alone";
+  EXPECT_NE(s["message"].get<std::string>().find("transmitter markers off"), std::string::npos) << s["message"];
+  EXPECT_EQ(red(v.screenshot()), 0u);
+  v.tap("x");
+  s = v.settle();
+  EXPECT_TRUE(s["markers"].get<bool>());
+  EXPECT_EQ(s["merge"]["merged_surfaces"].get<int>(), 1);
+  EXPECT_GT(red(v.screenshot()), shown / 2);
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+}
+
+// Two Shift-clicks, a quarter of the window left and right of the centre looking straight
+// down: the link between the two picked points is drawn over the terrain in the path's
+// colours and its plot is written where --profile-plot says. The plot and the loss are what
+// `terravol profile` gives for the same two points; the status names the file.
+TEST(ViewCli, TwoShiftClicksDrawTheProfilePathAndWriteTheProfilesPlot) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto plot = dir.path() / "link.png";
+  Viewer v(bundled_dem() + " --camera 45.51,6.52,6000,0,-90 --profile-plot " + plot.string() + kSmall);
+  ASSERT_TRUE(v.start());
+  v.settle();
+  const std::initializer_list<test::Rgb8> path_colors = {{0, 200, 255}, {255, 200, 0}, {255, 0, 200}};
+  const std::size_t before = pixels_near(v.screenshot(), path_colors, 30);
+  const int y = v.height() / 2;
+  v.xdo("keydown shift");
+  v.xdo("mousemove --window " + v.window() + " " + std::to_string(v.width() / 4) + " " + std::to_string(y));
+  v.xdo("click 1");
+  ASSERT_TRUE(v.wait_for([](const json& s) { return s.contains("profile") && s["profile"]["to"].is_null(); }, 10.0))
+      << v.stderr_text();
+  EXPECT_EQ(v.status()["message"].get<std::string>().rfind("profile from ", 0), 0u);
+  v.xdo("mousemove --window " + v.window() + " " + std::to_string(3 * v.width() / 4) + " " + std::to_string(y));
+  v.xdo("click 1");
+  v.xdo("keyup shift");
+  ASSERT_TRUE(v.wait_for([](const json& s) { return s.contains("profile") && s["profile"].contains("file"); }, 20.0))
+      << v.stderr_text() << v.status().dump();
+  const json s = v.settle();
+  const json p = s["profile"];
+  EXPECT_EQ(p["file"].get<std::string>(), plot.string());
+  EXPECT_NE(s["message"].get<std::string>().find("wrote " + plot.string()), std::string::npos) << s["message"];
+  // West to east across the centre, at the camera's latitude.
+  EXPECT_NEAR(p["from"]["lat"].get<double>(), 45.51, 2e-3) << p;
+  EXPECT_NEAR(p["to"]["lat"].get<double>(), 45.51, 2e-3) << p;
+  EXPECT_LT(p["from"]["lon"].get<double>(), 6.52);
+  EXPECT_GT(p["to"]["lon"].get<double>(), 6.52);
+  EXPECT_GT(p["path_triangles"].get<int>(), 0);
+  // The path is drawn in its colours (the bundled terrain has none of them).
+  const std::size_t after = pixels_near(v.screenshot(), path_colors, 30);
+  EXPECT_GT(after, before + 200) << before << " before, " << after << " after";
+  std::printf("profile path: %.2f km, %d triangles, link %.0f ms, merge %.0f ms, plot %.0f ms; %zu path pixels\n",
+              p["distance_km"].get<double>(), p["path_triangles"].get<int>(), p["profile_ms"].get<double>(),
+              p["merge_ms"].get<double>(), p["plot_ms"].get<double>(), after - before);
+  // terravol profile between the same two points: the same loss and verdict, the same plot.
+  char args[256];
+  std::snprintf(args, sizeof args, " --from %.17g,%.17g,30 --to %.17g,%.17g,10 ", p["from"]["lat"].get<double>(),
+                p["from"]["lon"].get<double>(), p["to"]["lat"].get<double>(), p["to"]["lon"].get<double>());
+  const auto cli_png = dir.path() / "cli.png";
+  const auto r = test::run_terravol("profile" + std::string(args) + "--dem " + bundled_dem() + " -o " + cli_png.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::size_t at = r.out.find("  path loss ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NEAR(std::strtod(r.out.c_str() + at + 12, nullptr), p["path_loss_db"].get<double>(), 0.01);
+  EXPECT_NE(r.out.find("verdict: " + p["verdict"].get<std::string>() + "\n"), std::string::npos) << r.out << p;
+  const test::Image mine = test::read_png(plot), theirs = test::read_png(cli_png);
+  ASSERT_EQ(mine.width, 1200);
+  ASSERT_EQ(mine.height, 600);
+  ASSERT_EQ(theirs.width, mine.width);
+  ASSERT_EQ(theirs.height, mine.height);
+  EXPECT_LT(test::differing_share(mine, theirs, 8), 0.001) << "pixels differing from terravol profile's plot";
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
 
 // The overlay's parts as the status gives them: {x, y, w, h} in window pixels, or none.
@@ -830,7 +945,8 @@ TEST(ViewCli, RecordedKeyframesSaveACameraPathThatLoadsBack) {
 TEST(ViewCli, HelpListsTheKeyBindings) {
   const auto r = test::run_terravol("view --help");
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* text : {"W / S", "wireframe", "LOD colours", "sliding", "Esc", "--status", "--threshold"}) {
+  for (const char* text : {"W / S", "wireframe", "LOD colours", "sliding", "Esc", "--status", "--threshold",
+                           "Shift+click", "transmitter markers", "--profile-plot"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
 }
@@ -856,6 +972,26 @@ TEST(ViewCli, ACameraBeyondTheDemSeesTheTileAndFlyingAwayStopsAt200Km) {
   v.hold_until("s", [](const json&) { return false; }, 1.0);  // on against the limit for a second
   const json s1 = v.settle();
   EXPECT_NEAR(s1["camera"]["lat"].get<double>(), 45.0 - 199.8 / 111.2, 1e-3) << "stopped 200 km south of the tile";
+}
+
+// The profile options' bad values, and no display: one line each, before any window opens.
+TEST(ViewCli, BadProfileOptionsOrNoDisplayFailWithOneLine) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"view " + bundled_dem() + " --profile-agl 30", "terravol: --profile-agl 30: expected TX,RX"},
+      {"view " + bundled_dem() + " --profile-agl 30,-1", "terravol: --profile-agl 30,-1: expected TX,RX"},
+      {"view " + bundled_dem() + " --profile-freq 0", "terravol: --profile-freq: must be within (0, 100000] MHz"},
+      {"view " + bundled_dem() + " --profile-plot /nonexistent-folder/p.png",
+       "terravol: --profile-plot /nonexistent-folder/p.png: folder /nonexistent-folder does not exist"},
+  };
+  for (const auto& [args, prefix] : cases) {
+    const auto r = test::run_terravol(args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  const auto r = test::run_terravol_under("env -u DISPLAY", "view " + bundled_dem());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err.rfind("terravol: view needs an X display", 0), 0u) << r.err;
 }
 
 }  // namespace
