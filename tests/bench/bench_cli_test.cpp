@@ -120,7 +120,7 @@ TEST(BenchCli, LowAltitudeSuiteCullsOnlyHiddenTrianglesAndKeepsImagesIdentical) 
   EXPECT_EQ(f["every_node"]["tests_over_every_node"].get<double>(), 1.0);
   std::ifstream md(dir.path() / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
-  EXPECT_NE(report.find("## 9. Low altitude"), std::string::npos);
+  EXPECT_NE(report.find("## 10. Low altitude"), std::string::npos);
 }
 
 }  // namespace
