@@ -66,6 +66,24 @@ TEST(RenderCli, DefaultSkyViewOfTheBundledDemIsWritten) {
   EXPECT_LT(test::color_share(img, img.at(img.width / 2, 0), 2), 0.5);
 }
 
+// Renders `view` (everything of the command line but the output) with --order bsp and with
+// --order zbuffer (VTK's depth-tested draw of the very same triangles) into `dir`; expects at
+// most 0.5% of pixels to differ (silhouettes) and returns the bsp image.
+test::Image expect_bsp_matches_zbuffer(const test::TempDir& dir, const std::string& view) {
+  const auto bsp = dir.path() / "bsp.png", zbuffer = dir.path() / "zbuffer.png";
+  auto r = run_terravol("render " + view + " -o " + bsp.string() + " --order bsp");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run_terravol("render " + view + " -o " + zbuffer.string() + " --order zbuffer");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const auto a = test::read_png(bsp), b = test::read_png(zbuffer);
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  if (a.width != b.width || a.height != b.height) return a;
+  const double share = test::differing_share(a, b, 8);
+  EXPECT_LE(share, 0.005) << share * 100 << "% of pixels differ";
+  return a;
+}
+
 // The tree's back-to-front order with no depth test against VTK's depth-tested draw of the
 // very same triangles (opaque terrain): only silhouette pixels may differ.
 TEST(RenderCli, BspOrderMatchesTheDepthBufferReference) {
@@ -73,17 +91,7 @@ TEST(RenderCli, BspOrderMatchesTheDepthBufferReference) {
   const auto dem = test::shared_dem("N44W072.hgt");
   TERRAVOL_REQUIRE_SHARED(dem);
   test::TempDir dir;
-  const std::string view = dem.string() + " --camera 44.12,-71.5,2200,40,-5 --size 960x540 -o ";
-  const auto bsp = dir.path() / "bsp.png", zbuffer = dir.path() / "zbuffer.png";
-  auto r = run_terravol("render " + view + bsp.string() + " --order bsp");
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = run_terravol("render " + view + zbuffer.string() + " --order zbuffer");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const auto a = test::read_png(bsp), b = test::read_png(zbuffer);
-  ASSERT_EQ(a.width, b.width);
-  ASSERT_EQ(a.height, b.height);
-  const double share = test::differing_share(a, b, 8);
-  EXPECT_LE(share, 0.005) << share * 100 << "% of pixels differ";
+  expect_bsp_matches_zbuffer(dir, dem.string() + " --camera 44.12,-71.5,2200,40,-5 --size 960x540");
 }
 
 // A camera beyond the DEM (south of the bundled tile, low, looking north) sees the window's
@@ -120,15 +128,7 @@ TEST(RenderCli, CameraBeyondTheDemSeesTheTileClosedByAWall) {
 TEST(RenderCli, BspOrderFromBeyondTheDemMatchesTheDepthBufferReference) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;
-  const std::string view = bundled_dem() + " --agl --camera 44.93,5.95,900,40,-6 --size 480x270 -o ";
-  const auto bsp = dir.path() / "bsp.png", zbuffer = dir.path() / "zbuffer.png";
-  auto r = run_terravol("render " + view + bsp.string() + " --order bsp");
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = run_terravol("render " + view + zbuffer.string() + " --order zbuffer");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const auto a = test::read_png(bsp), b = test::read_png(zbuffer);
-  const double share = test::differing_share(a, b, 8);
-  EXPECT_LE(share, 0.005) << share * 100 << "% of pixels differ";
+  const auto a = expect_bsp_matches_zbuffer(dir, bundled_dem() + " --agl --camera 44.93,5.95,900,40,-6 --size 480x270");
   EXPECT_GT(test::color_share(a, test::Rgb8{112, 96, 78}, 60), 0.02) << "two walls are seen";
 }
 
