@@ -100,6 +100,7 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
       ColorTexture{scene_->cells() + 1, lattice_.rgba});
   renderer_->set_vertex_version(tree.merged_version());
   if (options_.legend) renderer_->set_legend(volumes_.legend());
+  renderer_->set_labels(volumes_.marker_labels());
 }
 
 SceneRenderer::~SceneRenderer() = default;
@@ -322,6 +323,7 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
   sync_vertices(*renderer_);
   if (options_.legend) renderer_->set_legend(volumes_.legend());
+  renderer_->set_labels(volumes_.marker_labels());
   return volumes_.figures();
 }
 

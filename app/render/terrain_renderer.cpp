@@ -508,6 +508,25 @@ void TerrainRenderer::release_vertices() {
   if (split_orders()) merged_poly_->Modified();
 }
 
+void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) {
+  for (const auto& a : labels_) renderer_->RemoveActor(a);
+  labels_.clear();
+  for (const scene::MarkerLabel& l : labels) {
+    auto a = vtkSmartPointer<vtkBillboardTextActor3D>::New();
+    a->SetInput(l.text.c_str());
+    a->SetPosition(l.at.x, l.at.y, l.at.z);
+    vtkTextProperty* t = a->GetTextProperty();
+    t->SetFontSize(18);
+    t->BoldOn();
+    t->ShadowOn();
+    t->SetColor(1.0, 1.0, 1.0);
+    t->SetJustificationToCentered();
+    t->SetVerticalJustificationToBottom();
+    renderer_->AddActor(a);
+    labels_.push_back(a);
+  }
+}
+
 void TerrainRenderer::set_legend(const scene::Legend& legend) {
   legend_card_.reset();
   legend_cache_ = {};

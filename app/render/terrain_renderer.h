@@ -6,6 +6,7 @@
 // texture.
 #pragma once
 
+#include <vtkBillboardTextActor3D.h>
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 
@@ -143,6 +144,11 @@ class TerrainRenderer {
   // the background.
   void release_vertices();
 
+  // The transmitter markers' names, drawn over the scene as billboard text (white, with a
+  // shadow, centred above each anchor; VTK projects the anchors with the camera), replacing the
+  // last ones. Labels are not part of the tree's order: like the legend, they lie over the image.
+  void set_labels(const std::vector<scene::MarkerLabel>& labels);
+
   // The colour legend, drawn as a card (legend_image: the slice's map, each isosurface level
   // marked on it and given a swatch), or none when `legend` is empty.
   void set_legend(const scene::Legend& legend);
@@ -200,6 +206,7 @@ class TerrainRenderer {
   std::optional<std::array<int, 4>> legend_box_;
   vtkNew<vtkImageData> legend_data_;
   vtkNew<vtkActor2D> legend_actor_;
+  std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
   std::vector<std::uint32_t> split_terrain_, split_merged_;  // set_frame's buffers (split orders)
   std::vector<std::int8_t> split_levels_;
   vtkNew<vtkRenderer> renderer_;

@@ -52,6 +52,17 @@ std::vector<volume::RecordedTransmitter> transmitters_of(const volume::Volume& v
 // ground to the antenna, and on it an octahedron of radius 100 m whose lowest vertex is the
 // antenna, opaque red, so that it shows as some ten pixels from 10 km. Built by hand: eight vertices and twelve triangles each
 // need no library.
+// The markers' labels (MarkerLabel): the octahedron's top is 200 m above the antenna.
+std::vector<MarkerLabel> marker_labels_of(const std::vector<volume::RecordedTransmitter>& tx, const io::SceneFrame& frame,
+                                          const GroundGrid& ground) {
+  std::vector<MarkerLabel> out;
+  for (const auto& t : tx) {
+    const io::ScenePoint p = frame.to_scene({t.lat, t.lon, ground(t.lat, t.lon) + std::max(t.height_agl, 1.0) + 220.0});
+    out.push_back({glm::dvec3(p.x, p.y, p.z), t.name.empty() ? "tx" : t.name});
+  }
+  return out;
+}
+
 volume::Mesh marker_mesh(const std::vector<volume::RecordedTransmitter>& tx, const io::SceneFrame& frame,
                          const GroundGrid& ground) {
   volume::Mesh m;
@@ -99,6 +110,7 @@ struct VolumeLayer::Loaded {
   std::unique_ptr<volume::LatticeMapper> mapper;
   std::vector<volume::Mesh> isosurfaces, slices;
   volume::Mesh markers;  // its transmitters' masts (shown with markers_shown_)
+  std::vector<MarkerLabel> labels;  // and their names
   // Changed since the last merge_into(), each surface (isosurfaces, slices, then the markers);
   // a change of the volume's visibility changes all of them.
   std::vector<bool> changed;
@@ -161,6 +173,7 @@ VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic&
     for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
     for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
     v->markers = marker_mesh(transmitters_of(v->data), frame, v->ground);
+    v->labels = marker_labels_of(transmitters_of(v->data), frame, v->ground);
     v->changed.assign(v->isosurfaces.size() + v->slices.size() + 1, true);
     volumes_.push_back(std::move(v));
   }
@@ -215,6 +228,14 @@ void VolumeLayer::set_visible(std::size_t volume, bool visible) {
   Loaded& v = *volumes_[volume];
   if (v.spec.visible != visible) v.changed.assign(v.changed.size(), true);
   v.spec.visible = visible;
+}
+
+std::vector<MarkerLabel> VolumeLayer::marker_labels() const {
+  std::vector<MarkerLabel> out;
+  if (!markers_shown_) return out;
+  for (const auto& v : volumes_)
+    if (v->spec.visible) out.insert(out.end(), v->labels.begin(), v->labels.end());
+  return out;
 }
 
 void VolumeLayer::set_markers(bool shown) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "app/scene/scene_file.h"
 #include "app/scene/terrain_colors.h"
 #include "app/scene/terrain_scene.h"
@@ -52,6 +54,13 @@ struct Legend {
 };
 
 // A volume's value at a point (VolumeLayer::values_at).
+// A transmitter marker's label: the transmitter's name ("tx" for an unnamed one), anchored
+// 20 m above the top of its marker (scene frame, metres).
+struct MarkerLabel {
+  glm::dvec3 at{0.0};
+  std::string text;
+};
+
 struct PointValue {
   std::string volume;  // the file's name, and the field
   std::string units;
@@ -100,6 +109,9 @@ class VolumeLayer {
   // next merge_into() removes or merges them alone).
   void set_markers(bool shown);
   bool markers_shown() const { return markers_shown_; }
+  // The labels of the markers shown now (visible volumes' transmitters, with markers on), in
+  // volume order, for the renderer to draw over the scene.
+  std::vector<MarkerLabel> marker_labels() const;
 
   // The legend of the first visible volume with a style: its first slice's colour map over the
   // slice's range, and every isosurface level with its colour; for a "categorical" slice no

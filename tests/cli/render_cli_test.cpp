@@ -282,27 +282,47 @@ TEST(RenderCli, CameraBelowTheGroundOrBadLevelsFailCleanly) {
   expect_clean_failure(dem + " --camera 45.5,6.5,5000,0,-10 --levels 20", "--levels");
 }
 
-// The transmitter a volume records gets a red mast; --no-markers leaves it out and nothing else
-// changes. The volume has no isosurface or slice, so the mast is all that is merged.
-TEST(RenderCli, TheTransmitterAVolumeRecordsGetsAMarkerUnlessNoMarkers) {
+// The transmitter a volume records gets a red mast with its name above it (white billboard
+// text: "tx" for a single rf volume's); --no-markers leaves both out and nothing else changes.
+// The volume has no isosurface or slice, so the mast is all that is merged.
+TEST(RenderCli, TheTransmitterAVolumeRecordsGetsALabelledMarkerUnlessNoMarkers) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;
   const std::string vdb = (dir.path() / "rf.vdb").string();
   const auto rf = test::run_terravol("rf --quiet --tx 45.5,6.5,30 --dem " + bundled_dem() +
                                      " --radius-km 2 --heights 0:200:100 -o " + vdb, 300);
   ASSERT_EQ(rf.status, 0) << rf.err;
-  const auto red_pixels = [&](const std::string& extra) {
+  struct Seen {
+    std::size_t red = 0, white = 0;
+    int red_top = 1 << 30, white_bottom = -1;  // image rows, 0 at the top
+  };
+  const auto seen = [&](const std::string& extra) {
     const std::string png = (dir.path() / ("m" + std::to_string(extra.size()) + ".png")).string();
     const auto r = test::run_terravol("render " + bundled_dem() + " --volume " + vdb +
-                                      " --camera 45.47,6.47,400,45,-8 --agl --size 320x180 -o " + png + extra);
+                                      " --camera 45.47,6.47,400,45,-8 --agl --size 640x360 -o " + png + extra);
     EXPECT_EQ(r.status, 0) << r.err;
     const test::Image img = test::read_png(png);
-    std::size_t n = 0;
-    for (const auto& p : img.pixels) n += p[0] > 180 && p[1] < 80 && p[2] < 90;
-    return n;
+    Seen s;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const auto& p = img.at(x, y);
+        if (p[0] > 180 && p[1] < 80 && p[2] < 90) {
+          ++s.red;
+          s.red_top = std::min(s.red_top, y);
+        }
+        if (p[0] > 245 && p[1] > 245 && p[2] > 245) {
+          ++s.white;
+          s.white_bottom = std::max(s.white_bottom, y);
+        }
+      }
+    return s;
   };
-  EXPECT_GT(red_pixels(""), 20u) << "a mast and its diamond some ten pixels across";
-  EXPECT_EQ(red_pixels(" --no-markers"), 0u);
+  const Seen with = seen(""), without = seen(" --no-markers");
+  EXPECT_GT(with.red, 20u) << "a mast and its diamond some ten pixels across";
+  EXPECT_GT(with.white, 10u) << "the label";
+  EXPECT_LE(with.white_bottom, with.red_top + 2) << "the label stands above the marker";
+  EXPECT_EQ(without.red, 0u);
+  EXPECT_EQ(without.white, 0u);
 }
 
 }  // namespace
