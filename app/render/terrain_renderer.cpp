@@ -258,6 +258,13 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   window_->SetAlphaBitPlanes(settings.order == scene::DrawOrder::kPeel ? 1 : 0);  // depth peeling needs alpha
   window_->SetSize(settings.width, settings.height);
   window_->AddRenderer(renderer_);
+  // The markers' labels on a layer of their own over the scene, sharing its camera: its depth
+  // buffer starts clear, so they show over the terrain in every draw order alike.
+  window_->SetNumberOfLayers(2);
+  labels_renderer_->SetLayer(1);
+  labels_renderer_->InteractiveOff();
+  labels_renderer_->SetActiveCamera(renderer_->GetActiveCamera());
+  window_->AddRenderer(labels_renderer_);
 }
 
 TerrainRenderer::~TerrainRenderer() { window_->Finalize(); }
@@ -509,7 +516,7 @@ void TerrainRenderer::release_vertices() {
 }
 
 void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) {
-  for (const auto& a : labels_) renderer_->RemoveActor(a);
+  for (const auto& a : labels_) labels_renderer_->RemoveActor(a);
   labels_.clear();
   for (const scene::MarkerLabel& l : labels) {
     auto a = vtkSmartPointer<vtkBillboardTextActor3D>::New();
@@ -522,7 +529,7 @@ void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) 
     t->SetColor(1.0, 1.0, 1.0);
     t->SetJustificationToCentered();
     t->SetVerticalJustificationToBottom();
-    renderer_->AddActor(a);
+    labels_renderer_->AddActor(a);
     labels_.push_back(a);
   }
 }

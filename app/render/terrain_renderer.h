@@ -146,7 +146,8 @@ class TerrainRenderer {
 
   // The transmitter markers' names, drawn over the scene as billboard text (white, with a
   // shadow, centred above each anchor; VTK projects the anchors with the camera), replacing the
-  // last ones. Labels are not part of the tree's order: like the legend, they lie over the image.
+  // last ones. Labels are not part of the tree's order: like the legend they lie over the image,
+  // on a second layer, the same in every draw order.
   void set_labels(const std::vector<scene::MarkerLabel>& labels);
 
   // The colour legend, drawn as a card (legend_image: the slice's map, each isosurface level
@@ -207,6 +208,7 @@ class TerrainRenderer {
   vtkNew<vtkImageData> legend_data_;
   vtkNew<vtkActor2D> legend_actor_;
   std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels_;
+  vtkNew<vtkRenderer> labels_renderer_;  // layer 1: the labels over the scene
   std::vector<std::uint32_t> split_terrain_, split_merged_;  // set_frame's buffers (split orders)
   std::vector<std::int8_t> split_levels_;
   vtkNew<vtkRenderer> renderer_;
