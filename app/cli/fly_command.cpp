@@ -73,6 +73,14 @@ std::uint64_t file_hash(const std::filesystem::path& p) {
   return h;
 }
 
+// Throws std::invalid_argument("WHERE: LAT, LON is 250.0 km beyond the DEM (at most 200 km)")
+// for a camera farther beyond the mosaic than scene::kMaxKmBeyond.
+void require_near(const io::Mosaic& m, const std::string& where, double lat, double lon) {
+  const double km = scene::km_beyond(m, lat, lon);
+  if (km <= scene::kMaxKmBeyond) return;
+  throw std::invalid_argument(where + ": " + fixed(lat, 5) + ", " + fixed(lon, 5) + " is " + fixed(km, 1) +
+                              " km beyond the DEM (at most " + fixed(scene::kMaxKmBeyond, 0) + " km)");
+}
 
 // The keys around time t, for messages: "keys[2] and keys[3]" or "keys[2]".
 std::string keys_around(const std::vector<scene::PathKey>& keys, double t) {
@@ -213,11 +221,7 @@ void run_fly(const FlyOptions& o) {
   const scene::PathKey& k0 = file.keys.front();
   scene.camera = scene::SceneCamera{scene::CameraPose{k0.lat, k0.lon, k0.alt, 0.0, 0.0}, k0.agl, default_fov};
   io::Mosaic mosaic = io::Mosaic::open(scene.dems);
-  if (scene::km_beyond(mosaic, k0.lat, k0.lon) > scene::kMaxKmBeyond) {
-    throw std::invalid_argument(source + ": keys[0]: " + fixed(k0.lat, 5) + ", " + fixed(k0.lon, 5) + " is " +
-                                fixed(scene::km_beyond(mosaic, k0.lat, k0.lon), 1) + " km beyond the DEM (at most " +
-                                fixed(scene::kMaxKmBeyond, 0) + " km)");
-  }
+  require_near(mosaic, source + ": keys[0]", k0.lat, k0.lon);
   render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
   settings.height = height * factor;
@@ -234,11 +238,7 @@ void run_fly(const FlyOptions& o) {
     const scene::PathSample s = path.at(t);
     const std::string when = source + ": at t=" + fixed(t, 2) + " s (frame " + std::to_string(k) + ", " +
                              keys_around(file.keys, t) + ")";
-    if (scene::km_beyond(renderer.mosaic(), s.pose.lat, s.pose.lon) > scene::kMaxKmBeyond) {
-      throw std::invalid_argument(when + " the camera (" + fixed(s.pose.lat, 5) + ", " + fixed(s.pose.lon, 5) + ") is " +
-                                  fixed(scene::km_beyond(renderer.mosaic(), s.pose.lat, s.pose.lon), 1) +
-                                  " km beyond the DEM (at most " + fixed(scene::kMaxKmBeyond, 0) + " km)");
-    }
+    require_near(renderer.mosaic(), when + " the camera", s.pose.lat, s.pose.lon);
     const double ground = renderer.ground_height(s.pose.lat, s.pose.lon);
     const double clearance = path.agl() ? s.pose.alt : s.pose.alt - ground;
     if (!(clearance > 0.0)) {

@@ -264,6 +264,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   labels_renderer_->SetLayer(1);
   labels_renderer_->InteractiveOff();
   labels_renderer_->SetActiveCamera(renderer_->GetActiveCamera());
+  labels_renderer_->DrawOff();  // until there are labels: no second pass over the window
   window_->AddRenderer(labels_renderer_);
 }
 
@@ -518,6 +519,7 @@ void TerrainRenderer::release_vertices() {
 void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) {
   for (const auto& a : labels_) labels_renderer_->RemoveActor(a);
   labels_.clear();
+  labels_renderer_->SetDraw(labels.empty() ? 0 : 1);
   for (const scene::MarkerLabel& l : labels) {
     auto a = vtkSmartPointer<vtkBillboardTextActor3D>::New();
     a->SetInput(l.text.c_str());

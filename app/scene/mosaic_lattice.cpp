@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <stdexcept>
 
 namespace terravol::app::scene {
@@ -31,7 +32,7 @@ double km_beyond(const io::Mosaic& mosaic, double lat, double lon) {
   clamp_to_mosaic(mosaic, clat, clon);
   constexpr double kKmPerDegree = 111.2;
   const double north = (lat - clat) * kKmPerDegree;
-  const double east = std::remainder(lon - clon, 360.0) * kKmPerDegree * std::cos(lat * 3.14159265358979323846 / 180.0);
+  const double east = std::remainder(lon - clon, 360.0) * kKmPerDegree * std::cos(lat * std::numbers::pi / 180.0);
   return std::hypot(north, east);
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -39,7 +40,7 @@ TEST(MosaicLattice, CamerasMayLieUpTo200KmBeyondTheDem) {
   const io::Mosaic m = bundled();
   EXPECT_DOUBLE_EQ(km_beyond(m, 45.5, 6.5), 0.0);
   EXPECT_NEAR(km_beyond(m, 47.5, 6.5), 1.5 * 111.2, 1e-9);
-  EXPECT_NEAR(km_beyond(m, 45.5, 8.0), 111.2 * std::cos(45.5 * 3.14159265358979323846 / 180.0), 1e-9);
+  EXPECT_NEAR(km_beyond(m, 45.5, 8.0), 111.2 * std::cos(45.5 * std::numbers::pi / 180.0), 1e-9);
   EXPECT_NO_THROW(require_near(m, 45.5, 6.5));
   EXPECT_NO_THROW(require_near(m, 47.5, 6.5));
   try {
