@@ -995,6 +995,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
   for (Slot& slot : slots) {
     if (!slot.store.positions.empty() || slot.store.staged_refs < slot.store.refs.size()) flush(slot.store);
+    if (slot.built && std::binary_search(touched.begin(), touched.end(), slot.key)) slot.store.bound_nodes(positions);
   }
   std::size_t live = 0;
   for (const Slot& slot : slots) live += slot.store.refs.size();
@@ -1034,6 +1035,7 @@ void TerrainTree::Impl::build_pending(std::size_t k) {
   slot.built = true;
   slot.pending = 0;
   flush(slot.store);
+  slot.store.bound_nodes(positions);
   merge_stats.stored_polygons += slot.store.pieces;
   merge_stats.dropped_pieces += slot.store.dropped;
   merge_stats.merged_vertices = merged_colors.size();

@@ -193,6 +193,28 @@ std::size_t BspStore::bytes() const {
   return held(nodes) + held(polys) + held(refs) + held(positions) + held(colors);
 }
 
+void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
+  for (std::size_t k = nodes.size(); k-- > 0;) {
+    BspNode& bn = nodes[k];
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::uint32_t q = bn.first; q < bn.first + bn.count; ++q) {
+      const Polygon& p = polys[q];
+      for (std::uint32_t r = p.first; r < p.first + p.count; ++r) {
+        lo = glm::min(lo, where[refs[r]]);
+        hi = glm::max(hi, where[refs[r]]);
+      }
+    }
+    for (const std::int32_t child : {bn.back, bn.front}) {
+      if (child < 0) continue;  // none, or kDropSide
+      const BspNode& c = nodes[static_cast<std::size_t>(child)];
+      lo = glm::min(lo, c.lo);
+      hi = glm::max(hi, c.hi);
+    }
+    bn.lo = lo;
+    bn.hi = hi;
+  }
+}
+
 std::size_t SurfacePieces::bytes() const {
   return held(triangles) + held(vertices) + held(colors) + held(pieces) + held(refs);
 }
@@ -798,17 +820,30 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     out[2] = c;
     frame.level[triangles++] = level;
   };
-  // A slot's small BSP: the far side of each plane first.
+  // A slot's small BSP: the far side of each plane first. With culling, a subtree whose box
+  // lies outside the view frustum is left out (GL would clip all of it away), each box tested
+  // only against the planes its parent's box straddles.
   auto emit_store = [&](const BspStore& store) {
     auto& st = frame.leaf_stack_;
     st.clear();
-    if (store.root >= 0) st.push_back(store.root);
-    constexpr std::int32_t kEmitBit = std::int32_t{1} << 30;
+    // Items: node index, bit 31 set to emit the node's own polygons, bits 32-36 the planes left.
+    constexpr std::uint64_t kEmitBit = std::uint64_t{1} << 31;
+    const auto push_node = [&](std::int32_t node, int mask) {
+      if (node < 0) return;
+      if (options.cull && mask != 0) {
+        const BspNode& bn = store.nodes[static_cast<std::size_t>(node)];
+        mask = box_planes(planes, bn.lo, bn.hi, mask);
+        if (mask < 0) return;
+      }
+      st.push_back(static_cast<std::uint64_t>(node) | static_cast<std::uint64_t>(mask) << 32);
+    };
+    push_node(store.root, 31);
     while (!st.empty()) {
-      const std::int32_t top = st.back();
+      const std::uint64_t item = st.back();
       st.pop_back();
-      if (top & kEmitBit) {
-        const BspNode& bn = store.nodes[static_cast<std::size_t>(top & ~kEmitBit)];
+      const auto node = static_cast<std::size_t>(item & (kEmitBit - 1));
+      const BspNode& bn = store.nodes[node];
+      if (item & kEmitBit) {
         for (std::uint32_t k = 0; k < bn.count; ++k) {
           const Polygon& p = store.polys[bn.first + k];
           const std::uint32_t a = store.refs[p.first];
@@ -816,13 +851,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         }
         continue;
       }
-      const BspNode& bn = store.nodes[static_cast<std::size_t>(top)];
+      const int mask = static_cast<int>(item >> 32);
       const bool eye_front = glm::dot(glm::dvec3(bn.n), e) + static_cast<double>(bn.d) >= 0.0;
       const std::int32_t far_side = eye_front ? bn.back : bn.front, near_side = eye_front ? bn.front : bn.back;
       const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
-      if (second >= 0) st.push_back(second);
-      st.push_back(kEmitBit | top);
-      if (first >= 0) st.push_back(first);
+      push_node(second, mask);
+      st.push_back(kEmitBit | item);
+      push_node(first, mask);
     }
   };
   // A drawn cell's walls: on each window side the eye lies beyond and the cell touches, the

@@ -160,7 +160,7 @@ struct Frame {
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::uint64_t> stack_;
   std::vector<std::uint64_t> leaves_;
-  std::vector<std::int32_t> leaf_stack_;
+  std::vector<std::uint64_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found

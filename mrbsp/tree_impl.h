@@ -47,12 +47,15 @@ inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 // space below a low alternative's terrain triangle, where pieces are dropped). The plane is
 // kept in single precision (the pieces were split against it in double): it only tells the
 // eye's side, wrong at most for an eye within millimetres of it, where either order draws the
-// same.
+// same. lo and hi bound every polygon of the node's subtree (its own and both sides', as
+// drawn: positions() floats), so that a traversal leaves out subtrees outside the view
+// frustum (bound_nodes()); empty (lo > hi) when the subtree holds nothing.
 struct BspNode {
   glm::vec3 n{0.0f};
   float d = 0.0f;
   std::int32_t back = -1, front = -1;
   std::uint32_t first = 0, count = 0;  // into the store's polys
+  glm::vec3 lo{0.0f}, hi{-1.0f};
 };
 inline constexpr std::int32_t kDropSide = -2;
 
@@ -73,6 +76,11 @@ struct BspStore {
   std::size_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
+  // Sets every node's subtree box (BspNode::lo, hi) from its polygons' vertices, references
+  // into `positions` (the tree's positions(): call it once the store is flushed). Children
+  // follow their parents in `nodes` (build and insertion append them), so one pass from the
+  // last node up settles every box.
+  void bound_nodes(const std::vector<glm::vec3>& positions);
 };
 
 // Where merged polygons are kept. Per cell of level >= 0: kAbove holds the pieces of the
