@@ -590,9 +590,18 @@ class SlotBuilder {
   // many, and each is cheap: its bounding sphere decides its side unless the plane passes
   // through the sphere, and a candidate stops being counted once its spans alone score worse
   // than the best so far.
+  // Besides the polygons' own planes, vertical planes through the edges of nearly horizontal
+  // polygons are candidates: a surface over the ground such as an agl slice is a height field
+  // on the volume's lattice, and the vertical planes through its edges order it as the
+  // terrain's own planes order the terrain, cutting none of it (as an autopartition of its
+  // own tilted planes does). On the benchmark scene the slice then stores 1.25x its input
+  // (1.77x without), everything 2.01x (2.37x); hydrogen.vtk's closed surface 1.43x (1.37x:
+  // for a blob these planes win locally and cost more below; for steeper polygons they are
+  // not tried).
   bool choose(std::uint32_t begin, std::uint32_t end, PlaneD& best) {
     constexpr std::uint32_t kCandidates = 16, kSamples = 512;
-    constexpr double kW = 8.0;  // a span costs as much as this much imbalance
+    constexpr double kW = 8.0;     // a span costs as much as this much imbalance
+    constexpr double kFlat = 0.8;  // |n.z| of a polygon whose edge's vertical plane is a candidate
     const std::uint32_t size = end - begin;
     const std::uint32_t candidates = std::min(size, size <= 4 ? 2u : kCandidates), samples = std::min(size, kSamples);
     // The samples' spheres, packed (floats suffice: they only guide the choice; the partition
@@ -607,10 +616,31 @@ class SlotBuilder {
     }
     double best_score = std::numeric_limits<double>::max();
     bool found = false;
-    for (std::uint32_t c = 0; c < candidates; ++c) {
-      const Poly& candidate = polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(c) * size / candidates)]];
+    // Candidates 0 .. candidates-1: the polygons' own planes; then, for every second of those
+    // polygons that lies within about 37 degrees of horizontal, the vertical plane through its
+    // longest edge.
+    for (std::uint32_t c = 0; c < candidates + candidates / 2; ++c) {
+      const bool vertical = c >= candidates;
+      const std::uint32_t which = vertical ? 2 * (c - candidates) + 1 : c;
+      const Poly& candidate = polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(which) * size / candidates)]];
       if (!candidate.flat) continue;
-      const PlaneD& plane = candidate.plane;
+      if (vertical && std::abs(candidate.plane.n.z) < kFlat) continue;
+      PlaneD vplane;
+      if (vertical) {
+        double best_len = 0;
+        for (std::uint32_t k = 0; k < candidate.count; ++k) {
+          const glm::dvec3 a = pos(ids_[candidate.first + k]), b = pos(ids_[candidate.first + (k + 1) % candidate.count]);
+          const glm::dvec2 e(b.x - a.x, b.y - a.y);
+          const double len = glm::length(e);
+          if (len > best_len) {
+            best_len = len;
+            vplane.n = glm::dvec3(-e.y / len, e.x / len, 0.0);
+            vplane.d = -glm::dot(vplane.n, a);
+          }
+        }
+        if (!(best_len > 1e-6)) continue;
+      }
+      const PlaneD& plane = vertical ? vplane : candidate.plane;
       const glm::vec3 n(plane.n);
       const auto d = static_cast<float>(plane.d + glm::dot(plane.n, origin_));
       // Sides by sphere first (a loop without branches), then the polygons whose sphere the
@@ -642,6 +672,17 @@ class SlotBuilder {
         }
       }
       if (worse) continue;
+      if (vertical) {
+        // A plane through no polygon removes none: it must leave polygons on both sides, found
+        // exactly, so that each side is smaller than the range.
+        bool has_front = false, has_back = false;
+        for (std::uint32_t k = 0; k < samples && !(has_front && has_back); ++k) {
+          const Side side = classify(polys_[sample_polys_[k]], plane);
+          has_front |= side == Side::kFront;
+          has_back |= side == Side::kBack;
+        }
+        if (!has_front || !has_back) continue;
+      }
       const double score = kW * spans + std::abs(front - back);
       if (score < best_score) {
         best_score = score;
