@@ -194,14 +194,19 @@ std::size_t BspStore::bytes() const {
 }
 
 void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
+  const auto at = [&](std::uint32_t r) -> const glm::vec3& {
+    const std::uint32_t v = refs[r];
+    if (r < staged_refs) return where[v];
+    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
+  };
   for (std::size_t k = nodes.size(); k-- > 0;) {
     BspNode& bn = nodes[k];
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::uint32_t q = bn.first; q < bn.first + bn.count; ++q) {
       const Polygon& p = polys[q];
       for (std::uint32_t r = p.first; r < p.first + p.count; ++r) {
-        lo = glm::min(lo, where[refs[r]]);
-        hi = glm::max(hi, where[refs[r]]);
+        lo = glm::min(lo, at(r));
+        hi = glm::max(hi, at(r));
       }
     }
     for (const std::int32_t child : {bn.back, bn.front}) {

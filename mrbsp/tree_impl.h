@@ -76,10 +76,11 @@ struct BspStore {
   std::size_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
-  // Sets every node's subtree box (BspNode::lo, hi) from its polygons' vertices, references
-  // into `positions` (the tree's positions(): call it once the store is flushed). Children
-  // follow their parents in `nodes` (build and insertion append them), so one pass from the
-  // last node up settles every box.
+  // Sets every node's subtree box (BspNode::lo, hi) from its polygons' vertices: references
+  // into `where` (the tree's positions()), and those made since staged_refs as staged (before
+  // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
+  // their parents in `nodes` (build and insertion append them), so one pass from the last node
+  // up settles every box.
   void bound_nodes(const std::vector<glm::vec3>& positions);
 };
 
