@@ -190,7 +190,7 @@ std::size_t held(const std::vector<T>& v) {
 }  // namespace
 
 std::size_t BspStore::bytes() const {
-  return held(nodes) + held(polys) + held(refs) + held(positions) + held(colors);
+  return held(nodes) + held(boxes) + held(polys) + held(refs) + held(positions) + held(colors);
 }
 
 void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
@@ -199,8 +199,10 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
     if (r < staged_refs) return where[v];
     return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
   };
+  boxes.resize(nodes.size());
+  boxes.shrink_to_fit();
   for (std::size_t k = nodes.size(); k-- > 0;) {
-    BspNode& bn = nodes[k];
+    const BspNode& bn = nodes[k];
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::uint32_t q = bn.first; q < bn.first + bn.count; ++q) {
       const Polygon& p = polys[q];
@@ -211,12 +213,11 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
     }
     for (const std::int32_t child : {bn.back, bn.front}) {
       if (child < 0) continue;  // none, or kDropSide
-      const BspNode& c = nodes[static_cast<std::size_t>(child)];
+      const NodeBox& c = boxes[static_cast<std::size_t>(child)];
       lo = glm::min(lo, c.lo);
       hi = glm::max(hi, c.hi);
     }
-    bn.lo = lo;
-    bn.hi = hi;
+    boxes[k] = {lo, hi};
   }
 }
 
@@ -836,8 +837,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const auto push_node = [&](std::int32_t node, int mask) {
       if (node < 0) return;
       if (options.cull && mask != 0) {
-        const BspNode& bn = store.nodes[static_cast<std::size_t>(node)];
-        mask = box_planes(planes, bn.lo, bn.hi, mask);
+        const NodeBox& box = store.boxes[static_cast<std::size_t>(node)];
+        mask = box_planes(planes, box.lo, box.hi, mask);
         if (mask < 0) return;
       }
       st.push_back(static_cast<std::uint64_t>(node) | static_cast<std::uint64_t>(mask) << 32);

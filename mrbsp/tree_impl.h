@@ -47,14 +47,20 @@ inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 // space below a low alternative's terrain triangle, where pieces are dropped). The plane is
 // kept in single precision (the pieces were split against it in double): it only tells the
 // eye's side, wrong at most for an eye within millimetres of it, where either order draws the
-// same. lo and hi bound every polygon of the node's subtree (its own and both sides', as
-// drawn: positions() floats), so that a traversal leaves out subtrees outside the view
-// frustum (bound_nodes()); empty (lo > hi) when the subtree holds nothing.
+// same. 32 bytes: what a traversal reads at every node it passes; the node's box is in
+// BspStore::boxes.
 struct BspNode {
   glm::vec3 n{0.0f};
   float d = 0.0f;
   std::int32_t back = -1, front = -1;
   std::uint32_t first = 0, count = 0;  // into the store's polys
+};
+static_assert(sizeof(BspNode) == 32);
+
+// A box bounding every polygon of a node's subtree (its own and both sides', as drawn:
+// positions() floats), so that a traversal leaves out subtrees outside the view frustum;
+// empty (lo > hi) when the subtree holds nothing.
+struct NodeBox {
   glm::vec3 lo{0.0f}, hi{-1.0f};
 };
 inline constexpr std::int32_t kDropSide = -2;
@@ -65,6 +71,7 @@ inline constexpr std::int32_t kDropSide = -2;
 // vertices and makes those references global.
 struct BspStore {
   std::vector<BspNode> nodes;
+  std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
   std::vector<glm::vec3> positions;  // staged, empty once flushed
@@ -76,7 +83,7 @@ struct BspStore {
   std::size_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
-  // Sets every node's subtree box (BspNode::lo, hi) from its polygons' vertices: references
+  // Sets every node's subtree box (boxes) from its polygons' vertices: references
   // into `where` (the tree's positions()), and those made since staged_refs as staged (before
   // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
   // their parents in `nodes` (build and insertion append them), so one pass from the last node
