@@ -946,7 +946,8 @@ void TerrainTree::Impl::compact() {
   std::vector<glm::u8vec4> kept_colors;
   std::vector<glm::vec2> kept_tcoords;
   for (Slot& slot : slots) {
-    for (std::uint32_t& v : slot.store.refs) {
+    if (!slot.store) continue;
+    for (std::uint32_t& v : slot.store->refs) {
       if (v < base) continue;
       std::uint32_t& r = remap[v - base];
       if (r == std::numeric_limits<std::uint32_t>::max()) {
@@ -992,7 +993,7 @@ void TerrainTree::Impl::make_content() {
     if (key >= kOutsideKey0) continue;
     CellContent& c = content[static_cast<std::size_t>(content_index.find(key / 2))];
     (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
-    c.top = std::max(c.top, slots[k].built ? slots[k].store.top : slots[k].top);
+    c.top = std::max(c.top, slots[k].built ? slots[k].store->top : slots[k].top);
   }
   // Tops up the tree, finest first (cell ids grow with the level): every ancestor holds the
   // highest content of its subtree; the top levels in top_content.
@@ -1050,7 +1051,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
       }
     }
     if (slot.pending == 0) {  // nothing left here
-      if (slot.built) removed[k] = slot.store.refs.size();
+      removed[k] = slot.refs();
       slot = Slot{};
       slot.key = key;
       return;
@@ -1058,12 +1059,12 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     if (is_low(key) && !slot.built) return;  // built when first drawn
     bool anew = !slot.built;
     if (slot.built) {
-      removed[k] = remove_surfaces(slot.store, changed, positions);
-      anew = slot.store.pieces == 0 || slot.store.nodes.size() > 4 * slot.store.pieces + 64;
-      if (anew) removed[k] += slot.store.refs.size();
+      removed[k] = remove_surfaces(*slot.store, changed, positions);
+      anew = slot.store->pieces == 0 || slot.store->nodes.size() > 4 * slot.store->pieces + 64;
+      if (anew) removed[k] += slot.store->refs.size();
     }
-    if (anew) slot.store = BspStore{};
-    SlotBuilder builder(*this, slot.store);
+    if (anew) slot.store = std::make_unique<BspStore>();
+    SlotBuilder builder(*this, *slot.store);
     for (const auto& [id, s] : surfaces) {
       if (!anew && !std::binary_search(changed.begin(), changed.end(), id)) continue;
       for (auto [it, end] = arrivals(s, key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
@@ -1076,7 +1077,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     }
     slot.built = true;
     slot.pending = 0;
-    slot.store.bound_nodes(positions);  // read only here: flushes come after
+    slot.store->bound_nodes(positions);  // read only here: flushes come after
   });
   // Merge into the sorted slots: untouched ones kept, touched ones replaced (or gone when empty).
   std::vector<Slot> merged;
@@ -1097,15 +1098,15 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   merge_stats.rebuilt_slots += touched.size();
   for (std::size_t r : removed) dead_refs += r;
   std::size_t staged = 0;
-  for (const Slot& slot : slots) staged += slot.store.positions.size();
+  for (const Slot& slot : slots) staged += slot.store ? slot.store->positions.size() : 0;
   positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
   merged_colors.reserve(merged_colors.size() + staged);
   if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
   for (Slot& slot : slots) {
-    if (!slot.store.positions.empty() || slot.store.staged_refs < slot.store.refs.size()) flush(slot.store);
+    if (slot.store && (!slot.store->positions.empty() || slot.store->staged_refs < slot.store->refs.size())) flush(*slot.store);
   }
   std::size_t live = 0;
-  for (const Slot& slot : slots) live += slot.store.refs.size();
+  for (const Slot& slot : slots) live += slot.refs();
   if (dead_refs > live) compact();
   make_content();
 
@@ -1120,8 +1121,8 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     merge_stats.dropped_pieces += s.dropped;
   }
   for (const Slot& slot : slots) {
-    merge_stats.stored_polygons += slot.store.pieces;
-    merge_stats.dropped_pieces += slot.store.dropped;
+    merge_stats.stored_polygons += slot.store ? slot.store->pieces : 0;
+    merge_stats.dropped_pieces += slot.store ? slot.store->dropped : 0;
     merge_stats.pending_slots += slot.built ? 0 : 1;
     merge_stats.pending_pieces += slot.pending;
   }
@@ -1133,7 +1134,8 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
 void TerrainTree::Impl::build_pending(std::size_t k) {
   Slot& slot = slots[k];
   const auto t0 = Clock::now();
-  SlotBuilder builder(*this, slot.store);
+  slot.store = std::make_unique<BspStore>();
+  SlotBuilder builder(*this, *slot.store);
   for (const auto& [id, s] : surfaces) {
     for (auto [it, end] = arrivals(s, slot.key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
   }
@@ -1141,10 +1143,10 @@ void TerrainTree::Impl::build_pending(std::size_t k) {
   builder.build_low(c.level, c.ci, c.cj);
   slot.built = true;
   slot.pending = 0;
-  flush(slot.store);
-  slot.store.bound_nodes(positions);
-  merge_stats.stored_polygons += slot.store.pieces;
-  merge_stats.dropped_pieces += slot.store.dropped;
+  flush(*slot.store);
+  slot.store->bound_nodes(positions);
+  merge_stats.stored_polygons += slot.store->pieces;
+  merge_stats.dropped_pieces += slot.store->dropped;
   merge_stats.merged_vertices = merged_colors.size();
   --merge_stats.pending_slots;
   ++merge_stats.lazy_built_slots;

@@ -199,25 +199,47 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
     if (r < staged_refs) return where[v];
     return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
   };
-  boxes.resize(nodes.size());
+  // The store's bounds first: the grid the nodes' boxes are rounded to.
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (std::uint32_t r = 0; r < refs.size(); ++r) {
+    lo = glm::min(lo, glm::dvec3(at(r)));
+    hi = glm::max(hi, glm::dvec3(at(r)));
+  }
+  box_base = lo;
+  box_step = glm::max((hi - lo) / 65535.0, glm::dvec3(1e-9));
+  const auto down = [&](const glm::vec3& p) {
+    const glm::dvec3 q = glm::floor((glm::dvec3(p) - box_base) / box_step);
+    return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
+  };
+  const auto up = [&](const glm::vec3& p) {
+    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - box_base) / box_step);
+    return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
+  };
+  boxes.assign(nodes.size(), NodeBox{});
   boxes.shrink_to_fit();
   for (std::size_t k = nodes.size(); k-- > 0;) {
     const BspNode& bn = nodes[k];
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    glm::dvec3 qlo(65536.0), qhi(-1.0);
     for (std::uint32_t q = bn.first; q < bn.first + bn.count; ++q) {
       const Polygon& p = polys[q];
       for (std::uint32_t r = p.first; r < p.first + p.count; ++r) {
-        lo = glm::min(lo, at(r));
-        hi = glm::max(hi, at(r));
+        qlo = glm::min(qlo, down(at(r)));
+        qhi = glm::max(qhi, up(at(r)));
       }
     }
     for (const std::int32_t child : {bn.back, bn.front}) {
       if (child < 0) continue;  // none, or kDropSide
       const NodeBox& c = boxes[static_cast<std::size_t>(child)];
-      lo = glm::min(lo, c.lo);
-      hi = glm::max(hi, c.hi);
+      if (c.lo[0] > c.hi[0]) continue;  // empty
+      qlo = glm::min(qlo, glm::dvec3(c.lo[0], c.lo[1], c.lo[2]));
+      qhi = glm::max(qhi, glm::dvec3(c.hi[0], c.hi[1], c.hi[2]));
     }
-    boxes[k] = {lo, hi};
+    if (qlo.x > qhi.x) continue;  // empty: stays lo > hi
+    NodeBox& b = boxes[k];
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = static_cast<std::uint16_t>(qlo[a]);
+      b.hi[a] = static_cast<std::uint16_t>(qhi[a]);
+    }
   }
 }
 
@@ -236,7 +258,7 @@ MemoryStats TerrainTree::memory() const {
   s.merged = held(m.positions) - s.vertices + held(m.merged_colors) + held(m.surfaces) + held(m.slots) +
              held(m.content_index.bits) + held(m.content_index.rank) + held(m.content) + held(m.top_content);
   for (const auto& [id, surface] : m.surfaces) s.merged += surface.bytes();
-  for (const Slot& slot : m.slots) s.merged += slot.store.bytes();
+  for (const Slot& slot : m.slots) s.merged += slot.store ? sizeof(BspStore) + slot.store->bytes() : 0;
   for (const auto& level : m.top_content) s.merged += held(level);
   return s;
 }
@@ -829,6 +851,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // A slot's small BSP: the far side of each plane first. With culling, a subtree whose box
   // lies outside the view frustum is left out (GL would clip all of it away), each box tested
   // only against the planes its parent's box straddles.
+  // Every slot emitted is built: above and outside slots when merged, low ones by pass 4.
   auto emit_store = [&](const BspStore& store) {
     auto& st = frame.leaf_stack_;
     st.clear();
@@ -838,7 +861,15 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       if (node < 0) return;
       if (options.cull && mask != 0) {
         const NodeBox& box = store.boxes[static_cast<std::size_t>(node)];
-        mask = box_planes(planes, box.lo, box.hi, mask);
+        if (box.lo[0] > box.hi[0]) return;  // holds nothing
+        // Outward in double, then to floats rounded outward again: the box still holds the subtree.
+        const glm::dvec3 lo = store.box_base + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * store.box_step;
+        const glm::dvec3 hi = store.box_base + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * store.box_step;
+        const glm::vec3 flo(std::nextafter(static_cast<float>(lo.x), -INFINITY), std::nextafter(static_cast<float>(lo.y), -INFINITY),
+                            std::nextafter(static_cast<float>(lo.z), -INFINITY));
+        const glm::vec3 fhi(std::nextafter(static_cast<float>(hi.x), INFINITY), std::nextafter(static_cast<float>(hi.y), INFINITY),
+                            std::nextafter(static_cast<float>(hi.z), INFINITY));
+        mask = box_planes(planes, flo, fhi, mask);
         if (mask < 0) return;
       }
       st.push_back(static_cast<std::uint64_t>(node) | static_cast<std::uint64_t>(mask) << 32);
@@ -885,7 +916,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   };
   for (const std::uint64_t item : leaves) {
     if (kind_of(item) == kEmitSlot) {
-      emit_store(m.slots[static_cast<std::size_t>(slot_of(item))].store);
+      emit_store(*m.slots[static_cast<std::size_t>(slot_of(item))].store);
       continue;
     }
     const int level = level_index_of(item) - m.top;
@@ -911,7 +942,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
 
     const CellContent* content = content_of(level, ci, cj);
     if (content && content->low >= 0) {
-      emit_store(m.slots[static_cast<std::size_t>(content->low)].store);
+      emit_store(*m.slots[static_cast<std::size_t>(content->low)].store);
     } else {
       // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
       const double side = (m.xs[static_cast<std::size_t>(i1)] - m.xs[static_cast<std::size_t>(i0)]) * (e.y - m.ys[static_cast<std::size_t>(j0)]) -

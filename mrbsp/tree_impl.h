@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -58,10 +59,11 @@ struct BspNode {
 static_assert(sizeof(BspNode) == 32);
 
 // A box bounding every polygon of a node's subtree (its own and both sides', as drawn:
-// positions() floats), so that a traversal leaves out subtrees outside the view frustum;
-// empty (lo > hi) when the subtree holds nothing.
+// positions() floats), so that a traversal leaves out subtrees outside the view frustum: in
+// steps of BspStore::box_step from BspStore::box_base, rounded outward (lo down, hi up), so
+// that it holds the subtree; empty (lo > hi) when the subtree holds nothing. 12 bytes.
 struct NodeBox {
-  glm::vec3 lo{0.0f}, hi{-1.0f};
+  std::uint16_t lo[3] = {1, 1, 1}, hi[3] = {0, 0, 0};
 };
 inline constexpr std::int32_t kDropSide = -2;
 
@@ -72,6 +74,7 @@ inline constexpr std::int32_t kDropSide = -2;
 struct BspStore {
   std::vector<BspNode> nodes;
   std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
+  glm::dvec3 box_base{0.0}, box_step{1.0};  // the boxes' grid: the store's bounds in 65535 steps
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
   std::vector<glm::vec3> positions;  // staged, empty once flushed
@@ -83,7 +86,7 @@ struct BspStore {
   std::size_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
-  // Sets every node's subtree box (boxes) from its polygons' vertices: references
+  // Sets every node's subtree box (boxes, box_base, box_step) from its polygons' vertices: references
   // into `where` (the tree's positions()), and those made since staged_refs as staged (before
   // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
   // their parents in `nodes` (build and insertion append them), so one pass from the last node
@@ -156,7 +159,11 @@ struct Slot {
   bool built = false;
   std::size_t pending = 0;  // pieces arrived, while not built
   float top = 0.0f;         // highest vertex of the pieces arrived (the built store's is lower or equal)
-  BspStore store;
+  // Held apart (about 200 bytes of empty containers): most slots are low alternatives that are
+  // never built. Not null when built.
+  std::unique_ptr<BspStore> store;
+  // The store's, or 0 when there is none.
+  std::size_t refs() const { return store ? store->refs.size() : 0; }
 };
 
 struct TerrainTree::Impl {
