@@ -149,6 +149,7 @@ class Distributor {
     eps_ = 1e-9 * std::max(size, 1.0);
   }
 
+  // Every triangle anew.
   void run() {
     s_.pieces.clear();
     s_.refs.clear();
@@ -156,17 +157,46 @@ class Distributor {
     s_.colors.resize(s_.input_vertices);
     if (!s_.tcoords.empty()) s_.tcoords.resize(s_.input_vertices);
     s_.dropped = 0;
-    for (std::size_t t = 0; t + 2 < s_.triangles.size(); t += 3) {
-      pool_.clear();
-      pool_.insert(pool_.end(), {s_.triangles[t], s_.triangles[t + 1], s_.triangles[t + 2]});
-      if (!has_area(0, 3)) continue;  // zero-area triangles draw nothing
-      stack_.push_back({kChain, 0, 0, 0, 0, 0, 0, 3});
-      while (!stack_.empty()) {
-        const Work w = stack_.back();
-        stack_.pop_back();
-        step(w);
+    for (std::size_t t = 0; t < s_.triangles.size() / 3; ++t) send(t);
+    finish();
+  }
+
+  // After a slide (Impl::shift_merged): the pieces the surface has are those inside `kept`,
+  // the lattice rectangle of the window that was already in the old one; the triangles
+  // reaching beyond it are sent through the tree again, and what comes to a region inside it
+  // is left out (its pieces are there already).
+  void run_outside(const TerrainTree::Impl::Region& kept) {
+    kept_ = kept;
+    skip_kept_ = true;
+    const glm::dvec2 lo(m_.xs[static_cast<std::size_t>(kept.i0)], m_.ys[static_cast<std::size_t>(kept.j0)]);
+    const glm::dvec2 hi(m_.xs[static_cast<std::size_t>(kept.i1)], m_.ys[static_cast<std::size_t>(kept.j1)]);
+    for (std::size_t t = 0; t < s_.triangles.size() / 3; ++t) {
+      bool inside = true;
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3& v = s_.vertices[s_.triangles[3 * t + static_cast<std::size_t>(k)]];
+        inside = inside && v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y;
       }
+      if (!inside) send(t);
     }
+    finish();
+  }
+
+ private:
+  // Sends triangle t through the tree.
+  void send(std::size_t t) {
+    pool_.clear();
+    pool_.insert(pool_.end(), {s_.triangles[3 * t], s_.triangles[3 * t + 1], s_.triangles[3 * t + 2]});
+    if (!has_area(0, 3)) return;  // zero-area triangles draw nothing
+    stack_.push_back({kChain, 0, 0, 0, 0, 0, 0, 3});
+    while (!stack_.empty()) {
+      const Work w = stack_.back();
+      stack_.pop_back();
+      step(w);
+    }
+  }
+
+  // Sorts the pieces by slot (stable: in the order they came) and fits the storage.
+  void finish() {
     std::stable_sort(s_.pieces.begin(), s_.pieces.end(),
                      [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
     s_.vertices.shrink_to_fit();
@@ -176,7 +206,6 @@ class Distributor {
     s_.refs.shrink_to_fit();
   }
 
- private:
   // What to do with a polygon (pool_[first .. first + count)): kChain: the window's boundary
   // plane `stage` (0 west, 1 east, 2 south, 3 north; 4: inside, the root cell); kSquare: the
   // cell (level, ci, cj); kHalf: the x half `half` of that cell, to split at its middle y line.
@@ -300,6 +329,7 @@ class Distributor {
     const int level = w.level;
     const int s = m_.cell_size(level), half = s / 2;
     const int i0 = w.ci * s, j0 = w.cj * s;
+    if (skip_kept_ && w.kind == kSquare && kept_.holds(i0, j0, s)) return;  // its pieces are kept
     if (w.kind == kHalf) {
       const int j = j0 + half;
       const Parts p = split_axis(w.first, w.count, 1, m_.ys[static_cast<std::size_t>(j)], y_plane(j));
@@ -347,6 +377,8 @@ class Distributor {
   const TerrainTree::Impl& m_;
   SurfacePieces& s_;
   double eps_ = 0.0;
+  bool skip_kept_ = false;
+  TerrainTree::Impl::Region kept_;
   std::vector<std::uint32_t> pool_, back_, front_;
   std::vector<Work> stack_;
   EdgeCache cache_;
@@ -1199,6 +1231,96 @@ void TerrainTree::Impl::redistribute_all() {
   dead_refs = 0;
   ++merged_version;
   update(ids, touched);
+  merge_stats.merge_ms = ms_since(t0);
+}
+
+void TerrainTree::Impl::shift_merged(int di, int dj) {
+  const auto t0 = Clock::now();
+  merge_stats.rebuilt_slots = 0;
+  merge_stats.build_ms = 0.0;
+  merge_stats.lazy_built_slots = 0;
+  merge_stats.lazy_build_ms = 0.0;
+  // The overlap in the moved window's indices; a cell there was (ci + di / s, cj + dj / s).
+  const Region kept{std::max(0, -di), std::max(0, -dj), n - std::max(0, di), n - std::max(0, dj)};
+  const auto renamed = [&](SlotKey key) -> std::optional<SlotKey> {
+    if (key >= kOutsideKey0) return std::nullopt;  // beyond the old window: merged again
+    const CellName c = cell_name(*this, key / 2);
+    const int s = cell_size(c.level), ci = c.ci - di / s, cj = c.cj - dj / s;
+    if (!kept.holds(ci * s, cj * s, s)) return std::nullopt;
+    return static_cast<SlotKey>(cell_id(c.level, ci, cj)) * 2 + key % 2;
+  };
+
+  // Slots of cells in both windows, renamed, with their terrain triangles' lattice vertices.
+  std::vector<Slot> moved;
+  moved.reserve(slots.size());
+  for (Slot& slot : slots) {
+    const std::optional<SlotKey> key = renamed(slot.key);
+    if (!key) {
+      dead_refs += slot.refs();
+      continue;
+    }
+    slot.key = *key;
+    if (slot.store) {
+      for (std::uint32_t& r : slot.store->refs) {
+        if (r >= lattice_count()) continue;
+        const int i = static_cast<int>(r % static_cast<std::uint32_t>(n + 1)), j = static_cast<int>(r / static_cast<std::uint32_t>(n + 1));
+        r = vertex(i - di, j - dj);
+      }
+    }
+    moved.push_back(std::move(slot));
+  }
+  std::sort(moved.begin(), moved.end(), [](const Slot& a, const Slot& b) { return a.key < b.key; });
+  slots = std::move(moved);
+
+  // Each surface: its pieces in both windows renamed, the rest dropped, and what reaches beyond
+  // the overlap sent through the moved window (Distributor::run_outside); then its vertices
+  // less those no piece uses any more.
+  tbb::parallel_for(std::size_t{0}, surfaces.size(), [&](std::size_t k) {
+    SurfacePieces& s = surfaces[k].second;
+    std::vector<SurfacePieces::Piece> pieces;
+    std::vector<std::uint32_t> refs;
+    for (const SurfacePieces::Piece& p : s.pieces) {
+      const std::optional<SlotKey> key = renamed(p.slot);
+      if (!key) continue;
+      pieces.push_back({*key, static_cast<std::uint32_t>(refs.size()), p.count});
+      refs.insert(refs.end(), s.refs.begin() + p.first, s.refs.begin() + p.first + p.count);
+    }
+    s.pieces = std::move(pieces);
+    s.refs = std::move(refs);
+    Distributor(*this, s).run_outside(kept);
+    std::vector<std::uint32_t> remap(s.vertices.size(), 0);
+    for (std::uint32_t r : s.refs) remap[r] = 1;
+    std::uint32_t used = 0;
+    for (std::uint32_t v = 0; v < s.vertices.size(); ++v) {
+      if (v >= s.input_vertices && !remap[v]) continue;  // the input's are kept (slides send them again)
+      s.vertices[used] = s.vertices[v];  // used <= v: moves only downward, in order
+      s.colors[used] = s.colors[v];
+      if (!s.tcoords.empty()) s.tcoords[used] = s.tcoords[v];
+      remap[v] = used++;
+    }
+    for (std::uint32_t& r : s.refs) r = remap[r];
+    s.vertices.resize(used);
+    s.colors.resize(used);
+    if (!s.tcoords.empty()) s.tcoords.resize(used);
+    s.vertices.shrink_to_fit();
+    s.colors.shrink_to_fit();
+    s.tcoords.shrink_to_fit();
+  });
+  merge_stats.distribute_ms = ms_since(t0);
+
+  // The slots the new pieces reach (none of them kept): built by update() as edits are.
+  std::vector<SlotKey> touched;
+  std::vector<std::uint32_t> ids;
+  for (const auto& [id, s] : surfaces) {
+    ids.push_back(id);
+    for (const SurfacePieces::Piece& p : s.pieces) {
+      if (!touched.empty() && touched.back() == p.slot) continue;
+      const auto at = std::lower_bound(slots.begin(), slots.end(), p.slot, [](const Slot& a, SlotKey b) { return a.key < b; });
+      if (at == slots.end() || at->key != p.slot) touched.push_back(p.slot);
+    }
+  }
+  ++merged_version;  // the lattice vertices moved
+  update(ids, std::move(touched));
   merge_stats.merge_ms = ms_since(t0);
 }
 

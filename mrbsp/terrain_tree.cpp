@@ -75,11 +75,14 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
       throw std::invalid_argument("TerrainTree: plane offsets must increase strictly");
     }
   }
+  // A window moved over the same terrain keeps what lies in both (section 4.3): the cell figures
+  // here, the merged content below.
+  const std::optional<std::pair<int, int>> shift = positions.empty() ? std::nullopt : shift_of(w);
   xs.assign(w.xs.begin(), w.xs.end());
   ys.assign(w.ys.begin(), w.ys.end());
   const auto zw = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
-  positions.resize(merged_base());
+  if (!shift) positions.resize(merged_base());  // merged vertices come again; kept after a shift
   float lowest = std::numeric_limits<float>::max();
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
@@ -96,12 +99,21 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   }
 
   // LOD cells above the finest: z range and error from their samples, independent of each
-  // other (TBB over the cells of each level).
+  // other (TBB over the cells of each level); after a shift, a cell in both windows keeps its
+  // figures (copied from where it was).
+  const std::vector<CellZ> before = shift ? cellz : std::vector<CellZ>{};
   for (int level = 0; level + 1 < levels; ++level) {
     const int s = cell_size(level), c = cells_at(level);
     CellZ* out = cellz.data() + cellz_offset[static_cast<std::size_t>(level + top)];
+    const CellZ* was = shift ? before.data() + cellz_offset[static_cast<std::size_t>(level + top)] : nullptr;
+    const int dci = shift ? shift->first / s : 0, dcj = shift ? shift->second / s : 0;
     tbb::parallel_for(tbb::blocked_range<int>(0, c * c, 64), [&](const tbb::blocked_range<int>& range) {
       for (int k = range.begin(); k != range.end(); ++k) {
+        const int oi = k % c + dci, oj = k / c + dcj;  // where the cell was
+        if (was && oi >= 0 && oj >= 0 && oi < c && oj < c) {
+          out[static_cast<std::size_t>(k)] = was[static_cast<std::size_t>(oj * c + oi)];
+          continue;
+        }
         const int i0 = (k % c) * s, j0 = (k / c) * s;
         const float zsw = zw(i0, j0), zse = zw(i0 + s, j0), zne = zw(i0 + s, j0 + s), znw = zw(i0, j0 + s);
         float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
@@ -137,7 +149,39 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
         out[static_cast<std::size_t>(cj * c + ci)] = u;
       }
   }
-  redistribute_all();  // section 4.3: other objects are merged again into the moved tree
+  // Section 4.3: other objects are merged again into the moved tree; what lies in both windows
+  // stays.
+  if (shift) {
+    shift_merged(shift->first, shift->second);
+  } else {
+    redistribute_all();
+  }
+}
+
+std::optional<std::pair<int, int>> TerrainTree::Impl::shift_of(const TerrainWindow& w) const {
+  // The moved window's first plane among this one's (or this one's among the moved one's).
+  const auto offset = [&](const std::vector<double>& old, std::span<const double> moved) -> std::optional<int> {
+    const auto in_old = std::lower_bound(old.begin(), old.end(), moved.front());
+    if (in_old != old.end() && *in_old == moved.front()) return static_cast<int>(in_old - old.begin());
+    const auto in_moved = std::lower_bound(moved.begin(), moved.end(), old.front());
+    if (in_moved != moved.end() && *in_moved == old.front()) return -static_cast<int>(in_moved - moved.begin());
+    return std::nullopt;
+  };
+  const std::optional<int> di = offset(xs, w.xs), dj = offset(ys, w.ys);
+  if (!di || !dj) return std::nullopt;
+  const int s0 = cell_size(0);
+  if (*di % s0 != 0 || *dj % s0 != 0 || std::abs(*di) >= n || std::abs(*dj) >= n) return std::nullopt;
+  // The same planes and heights wherever the two overlap.
+  const std::size_t side = static_cast<std::size_t>(n) + 1;
+  const int i0 = std::max(0, -*di), i1 = n - std::max(0, *di), j0 = std::max(0, -*dj), j1 = n - std::max(0, *dj);
+  for (int i = i0; i <= i1; ++i)
+    if (w.xs[static_cast<std::size_t>(i)] != xs[static_cast<std::size_t>(i + *di)]) return std::nullopt;
+  for (int j = j0; j <= j1; ++j)
+    if (w.ys[static_cast<std::size_t>(j)] != ys[static_cast<std::size_t>(j + *dj)]) return std::nullopt;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i)
+      if (w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)] != z(i + *di, j + *dj)) return std::nullopt;
+  return std::pair{*di, *dj};
 }
 
 TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::make_unique<Impl>()) {

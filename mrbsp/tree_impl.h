@@ -14,6 +14,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -213,7 +215,25 @@ struct TerrainTree::Impl {
   // The figures of a cell at any level >= -top; the finest level's from its four samples.
   CellZ cell_z(int level, int ci, int cj) const;
 
+  // A rectangle of the lattice, samples [i0, i1] x [j0, j1] (window indices).
+  struct Region {
+    int i0 = 0, j0 = 0, i1 = -1, j1 = -1;
+    // Whether it holds the square of side s samples from (i, j).
+    bool holds(int i, int j, int s) const { return i >= i0 && j >= j0 && i + s <= i1 && j + s <= j1; }
+  };
+
+  // A new window (section 4.3). When it is this one moved by whole level-0 cells over the same
+  // terrain (the same plane offsets and heights where the two overlap: shift_of), what lies in
+  // both is kept: the overlap's cell figures, and its merged slots and pieces (shift_merged);
+  // the rest is computed anew.
   void refresh(const TerrainWindow& window);
+  // (di, dj) when `window` is this one moved by di columns and dj rows (multiples of the
+  // level-0 cell size, less than the window) over the same terrain; nothing otherwise.
+  std::optional<std::pair<int, int>> shift_of(const TerrainWindow& window) const;
+  // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
+  // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the
+  // triangles reaching beyond the overlap merged into the rest of the window.
+  void shift_merged(int di, int dj);
   // Merging (merge.cpp). distribute() sends one surface's triangles through the tree;
   // rebuild() makes the slots whose keys are in `dirty` again from every surface's pieces,
   // then the cell content and the merged vertices.
