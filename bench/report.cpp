@@ -156,7 +156,11 @@ void translucency_section(std::ostringstream& md, const json& results) {
        << (r.contains("isovalue_change_ms") ? spread(r["isovalue_change_ms"], "%.0f") : std::string("–"))
        << " ms (of which merge "
        << (r.contains("isovalue_change_merge_ms") ? spread(r["isovalue_change_merge_ms"], "%.0f") : std::string("–"))
-       << " ms).\n\n";
+       << " ms); a slide of the tree by one level-0 cell with the volumes merged "
+       << (r.contains("slide_with_volumes_ms") ? spread(r["slide_with_volumes_ms"], "%.0f") : std::string("–"))
+       << " ms (of which merge "
+       << (r.contains("slide_with_volumes_merge_ms") ? spread(r["slide_with_volumes_merge_ms"], "%.0f") : std::string("–"))
+       << " ms; the window read ahead).\n\n";
   }
 }
 
