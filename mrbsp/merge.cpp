@@ -24,6 +24,7 @@
 //     planes.
 // Classification is in double precision, with a tolerance relative to the window's size.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -31,6 +32,7 @@
 #include <span>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -142,6 +144,7 @@ glm::u8vec4 mix_color(glm::u8vec4 a, glm::u8vec4 b, double t) {
 
 // --- Distribution: one surface through the tree's planes --------------------------------------
 
+
 class Distributor {
  public:
   Distributor(const TerrainTree::Impl& m, SurfacePieces& s) : m_(m), s_(s) {
@@ -162,11 +165,13 @@ class Distributor {
   }
 
   // After a slide (Impl::shift_merged): the pieces the surface has are those inside `kept`,
-  // the lattice rectangle of the window that was already in the old one; the triangles
-  // reaching beyond it are sent through the tree again, and what comes to a region inside it
-  // is left out (its pieces are there already).
-  void run_outside(const TerrainTree::Impl::Region& kept) {
+  // the lattice rectangle of the window that was already in the old one, and those of the
+  // outside places that lie where places lay before (`kept_places`, their keys); the triangles reaching beyond
+  // the rectangle are sent through the tree again, and what comes to a region inside it, or to
+  // a kept band, is left out (its pieces are there already).
+  void run_outside(const TerrainTree::Impl::Region& kept, const std::unordered_set<SlotKey>& kept_places) {
     kept_ = kept;
+    kept_places_ = kept_places;
     skip_kept_ = true;
     const glm::dvec2 lo(m_.xs[static_cast<std::size_t>(kept.i0)], m_.ys[static_cast<std::size_t>(kept.j0)]);
     const glm::dvec2 hi(m_.xs[static_cast<std::size_t>(kept.i1)], m_.ys[static_cast<std::size_t>(kept.j1)]);
@@ -297,6 +302,56 @@ class Distributor {
     s_.refs.insert(s_.refs.end(), pool_.begin() + first, pool_.begin() + first + count);
   }
 
+  // What lies beyond boundary plane `side`, cut into that side's bands (the band planes are
+  // parallel to it; a piece in a band plane goes with the band nearer the window). A kept
+  // band's pieces are there already (run_outside).
+  void to_bands(int side, std::uint32_t first, std::uint32_t count) {
+    const int axis = side < 2 ? 0 : 1;
+    const bool low_side = side % 2 == 0;  // west and south lie below their planes
+    for (int band = 0; band < kBands; ++band) {
+      std::uint32_t near_first = first, near_count = count, far_count = 0, far_first = 0;
+      if (band + 1 < kBands) {
+        const Parts p = split_axis(first, count, axis, m_.band_plane(side, band + 1), band_plane_id(side, band));
+        // split_axis gives a piece lying in the plane to the back: for west and south that is
+        // beyond, so it is moved to the near side here.
+        const bool in_plane = p.coplanar;
+        near_first = low_side ? (in_plane ? p.back_first : p.front_first) : p.back_first;
+        near_count = low_side ? (in_plane ? p.back_count : p.front_count) : p.back_count;
+        far_first = low_side ? p.back_first : p.front_first;
+        far_count = low_side ? (in_plane ? 0 : p.back_count) : p.front_count;
+      }
+      if (near_count >= 3) to_columns(side, band, near_first, near_count);
+      if (far_count < 3) return;
+      first = far_first;
+      count = far_count;
+    }
+  }
+  // A south or north band's part cut into the window's level-0 columns (west and east bands
+  // are one column); a kept place's pieces are there already (run_outside).
+  void to_columns(int side, int band, std::uint32_t first, std::uint32_t count) {
+    const int columns = side < 2 ? 1 : m_.cells_at(0), s0 = m_.cell_size(0);
+    for (int column = 0; column < columns; ++column) {
+      std::uint32_t in_first = first, in_count = count;
+      bool rest = false;
+      if (column + 1 < columns) {
+        const int i = (column + 1) * s0;
+        const Parts p = split_axis(first, count, 0, m_.xs[static_cast<std::size_t>(i)], x_plane(i));
+        in_first = p.back_first;  // west of the line (a piece in it goes west)
+        in_count = p.back_count;
+        first = p.front_first;
+        count = p.front_count;
+        rest = count >= 3;
+      }
+      if (in_count >= 3 && !(skip_kept_ && kept_places_.count(outside_key(side, band, column)))) {
+        arrive(outside_key(side, band, column), in_first, in_count);
+      }
+      if (!rest) return;
+    }
+  }
+  std::uint32_t band_plane_id(int side, int band) const {
+    return static_cast<std::uint32_t>(2 * (m_.n + 1)) + m_.total_cells + static_cast<std::uint32_t>(side * kBands + band);
+  }
+
   std::uint32_t x_plane(int i) const { return static_cast<std::uint32_t>(i); }
   std::uint32_t y_plane(int j) const { return static_cast<std::uint32_t>(m_.n + 1 + j); }
 
@@ -322,7 +377,7 @@ class Distributor {
       const std::uint32_t out_count = low_side ? p.back_count : p.front_count;
       const std::uint32_t in_first = low_side ? p.front_first : p.back_first;
       const std::uint32_t in_count = low_side ? p.front_count : p.back_count;
-      if (out_count >= 3) arrive(kOutsideKey0 + w.stage, out_first, out_count);
+      if (out_count >= 3) to_bands(w.stage, out_first, out_count);
       if (in_count >= 3) stack_.push_back({kChain, static_cast<std::uint8_t>(w.stage + 1), 0, 0, 0, 0, in_first, in_count});
       return;
     }
@@ -379,6 +434,7 @@ class Distributor {
   double eps_ = 0.0;
   bool skip_kept_ = false;
   TerrainTree::Impl::Region kept_;
+  std::unordered_set<SlotKey> kept_places_;
   std::vector<std::uint32_t> pool_, back_, front_;
   std::vector<Work> stack_;
   EdgeCache cache_;
@@ -1034,12 +1090,12 @@ void TerrainTree::Impl::make_content() {
   content_index = {};
   release(content);
   release(top_content);
-  std::fill(std::begin(outside), std::end(outside), -1);
+  for (auto& side : outside) side.clear();
   std::vector<std::uint32_t> cells;
   for (std::size_t k = 0; k < slots.size(); ++k) {
     const SlotKey key = slots[k].key;
     if (key >= kOutsideKey0) {
-      outside[key - kOutsideKey0] = static_cast<std::int32_t>(k);
+      outside[static_cast<std::size_t>(outside_place(key).side)].push_back(static_cast<std::int32_t>(k));
       continue;
     }
     CellName c = cell_name(*this, key / 2);
@@ -1272,8 +1328,23 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   merge_stats.lazy_build_ms = 0.0;
   // The overlap in the moved window's indices; a cell there was (ci + di / s, cj + dj / s).
   const Region kept{std::max(0, -di), std::max(0, -dj), n - std::max(0, di), n - std::max(0, dj)};
+  // An outside place lies where one lay before when both are one level-0 cell wide between the
+  // same planes: west and east bands (any y) move by di / s0 bands; south and north bands by
+  // dj / s0 bands and their columns by di / s0 columns. The last bands (everything beyond) stay
+  // only where their plane did not move.
+  const int s0 = cell_size(0), columns = cells_at(0);
+  const auto moved_place = [&](SlotKey key) -> std::optional<SlotKey> {
+    const OutsidePlace p = outside_place(key);
+    // A band beyond a plane that moved toward it is nearer now, and farther when it moved away.
+    const int shift = p.side == 0 ? di / s0 : p.side == 1 ? -di / s0 : p.side == 2 ? dj / s0 : -dj / s0;
+    const int band = p.band == kBands - 1 ? p.band : p.band + shift, column = p.side < 2 ? 0 : p.column - di / s0;
+    if (p.band == kBands - 1 ? shift != 0 : band < 0 || band >= kBands - 1) return std::nullopt;
+    if (column < 0 || column >= (p.side < 2 ? 1 : columns)) return std::nullopt;
+    return outside_key(p.side, band, column);
+  };
+  std::unordered_set<SlotKey> kept_places;
   const auto renamed = [&](SlotKey key) -> std::optional<SlotKey> {
-    if (key >= kOutsideKey0) return std::nullopt;  // beyond the old window: merged again
+    if (key >= kOutsideKey0) return moved_place(key);  // beyond the old window: kept where it is, else merged again
     const CellName c = cell_name(*this, key / 2);
     const int s = cell_size(c.level), ci = c.ci - di / s, cj = c.cj - dj / s;
     if (!kept.holds(ci * s, cj * s, s)) return std::nullopt;
@@ -1290,6 +1361,7 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
       continue;
     }
     slot.key = *key;
+    if (*key >= kOutsideKey0) kept_places.insert(*key);
     if (slot.store) {
       for (std::uint32_t& r : slot.store->refs) {
         if (r >= lattice_count()) continue;
@@ -1317,7 +1389,7 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
     }
     s.pieces = std::move(pieces);
     s.refs = std::move(refs);
-    Distributor(*this, s).run_outside(kept);
+    Distributor(*this, s).run_outside(kept, kept_places);
     std::vector<std::uint32_t> remap(s.vertices.size(), 0);
     for (std::uint32_t r : s.refs) remap[r] = 1;
     std::uint32_t used = 0;

@@ -158,6 +158,13 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   }
 }
 
+double TerrainTree::Impl::band_plane(int side, int band) const {
+  const auto s0 = static_cast<std::size_t>(cell_size(0));
+  const std::vector<double>& lines = side < 2 ? xs : ys;
+  const double width = lines[s0] - lines[0];
+  return side % 2 == 0 ? lines.front() - band * width : lines.back() + band * width;
+}
+
 std::optional<std::pair<int, int>> TerrainTree::Impl::shift_of(const TerrainWindow& w) const {
   // The moved window's first plane among this one's (or this one's among the moved one's).
   const auto offset = [&](const std::vector<double>& old, std::span<const double> moved) -> std::optional<int> {
@@ -566,25 +573,47 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       stack.push_back(b2f ? near_item : far_item);
       stack.push_back(b2f ? far_item : near_item);
     };
-    // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
-    // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]). Built from the
-    // innermost out: the window, then each boundary plane's outside slot on the far or near
-    // side of what is inside it.
-    std::uint64_t order[5];
-    int count = 0;
-    order[count++] = pack(kSquare, 0, 0, 0);
+    // The window, inside the chain of its four boundary planes: beyond each lie the kOutside
+    // slots of one side (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]), in
+    // bands parallel to the plane. Built from the innermost out: the window, then each
+    // boundary plane's bands on the far or near side of what is inside it. A side's bands are
+    // slabs between parallel planes: back to front, those farther from the eye along the axis
+    // first (slabs on opposite sides of the eye cannot overlap on screen), the one holding the
+    // eye last.
+    auto& order = frame.outside_order_;
+    order.clear();
+    order.push_back(pack(kSquare, 0, 0, 0));
+    auto& places = frame.outside_places_;
     for (int side = 3; side >= 0; --side) {
-      if (m.outside[side] < 0) continue;
-      const std::uint64_t slot = pack_slot(m.outside[side]);
-      if (beyond[side] == b2f) {
-        order[count++] = slot;  // after everything inside
-      } else {
-        std::move_backward(order, order + count, order + count + 1);
-        order[0] = slot;
-        ++count;
+      const std::vector<std::int32_t>& slots = m.outside[static_cast<std::size_t>(side)];
+      if (slots.empty()) continue;
+      // Each place is a box: its band's slab across the side's axis, its column's along the
+      // other (south and north); sorted by the band's distance from the eye, then the column's.
+      const double eye_at = side < 2 ? e.x : e.y;
+      places.clear();
+      for (const std::int32_t slot : slots) {
+        const OutsidePlace p = outside_place(m.slots[static_cast<std::size_t>(slot)].key);
+        const double a = m.band_plane(side, p.band);
+        const double b = p.band + 1 < kBands ? m.band_plane(side, p.band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
+        double column_distance = 0.0;
+        if (side >= 2) {
+          const int s0 = m.cell_size(0);
+          const double x0 = m.xs[static_cast<std::size_t>(p.column * s0)], x1 = m.xs[static_cast<std::size_t>((p.column + 1) * s0)];
+          column_distance = e.x < x0 ? x0 - e.x : e.x > x1 ? e.x - x1 : 0.0;
+        }
+        const double lo = std::min(a, b), hi = std::max(a, b);
+        const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
+        places.push_back({band_distance, column_distance, slot});
       }
+      std::sort(places.begin(), places.end(), [&](const Frame::OutsideOrder& p, const Frame::OutsideOrder& q) {
+        if (p.band_distance != q.band_distance) return b2f ? p.band_distance > q.band_distance : p.band_distance < q.band_distance;
+        return b2f ? p.column_distance > q.column_distance : p.column_distance < q.column_distance;
+      });
+      for (const Frame::OutsideOrder& p : places) order.push_back(pack_slot(p.slot));
+      // After everything inside, or before it.
+      if (beyond[side] != b2f) std::rotate(order.begin(), order.end() - static_cast<std::ptrdiff_t>(places.size()), order.end());
     }
-    for (int k = count; k-- > 0;) stack.push_back(order[k]);
+    for (std::size_t k = order.size(); k-- > 0;) stack.push_back(order[k]);
     while (!stack.empty()) {
       const std::uint64_t item = stack.back();
       stack.pop_back();

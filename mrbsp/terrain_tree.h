@@ -160,6 +160,12 @@ struct Frame {
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::uint64_t> stack_;
   std::vector<std::uint64_t> leaves_;
+  std::vector<std::uint64_t> outside_order_;  // the window and the outside bands, in draw order
+  struct OutsideOrder {
+    double band_distance, column_distance;
+    std::int32_t slot;
+  };
+  std::vector<OutsideOrder> outside_places_;
   std::vector<std::uint64_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's

@@ -12,6 +12,7 @@
 // triangles) and its children (the high alternative).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -101,14 +102,32 @@ struct BspStore {
 // plane z = zmax: the eye's side of it is near), kLow the cell's low alternative: its two
 // terrain triangles and the pieces above them. Around the window, kOutside slots hold what
 // lies beyond its four boundary planes (west, east, south, north, in this order: a piece
-// beyond two belongs to the first).
+// beyond two belongs to the first), in bands one level-0 cell wide parallel to the plane: band
+// b of the west side lies between the planes x = xs[0] - (b + 1) w and x = xs[0] - b w (w the
+// level-0 cell's width), the last band (kBands - 1) everything beyond; south and north bands
+// lie between the west and east planes, cut further into the window's level-0 columns. A slide
+// by whole level-0 cells keeps most of them (Impl::shift_merged), and they are built apart (in
+// parallel, and none as large as all of a side).
 enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
+inline constexpr int kBands = 16;
+inline constexpr int kMaxColumns = 32768;  // level-0 columns of a window, at most
 
 // A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
-// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north). Cells number at most 1.5e9 (a
-// 32768-cell window), so keys fit 32 bits below kOutsideKey0.
+// outside_key(side, band, column) (side 0 west, 1 east, 2 south, 3 north; column 0 for west and
+// east). Cells number at most 1.5e9 (a 32768-cell window), so keys fit 32 bits below
+// kOutsideKey0.
 using SlotKey = std::uint32_t;
-inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFF0u;
+inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFFFu - 4u * kBands * kMaxColumns;
+inline constexpr SlotKey outside_key(int side, int band, int column) {
+  return kOutsideKey0 + static_cast<SlotKey>((side * kBands + band) * kMaxColumns + column);
+}
+struct OutsidePlace {
+  int side, band, column;
+};
+inline constexpr OutsidePlace outside_place(SlotKey key) {
+  const auto k = static_cast<int>(key - kOutsideKey0);
+  return {k / kMaxColumns / kBands, k / kMaxColumns % kBands, k % kMaxColumns};
+}
 
 // Which cells hold merged content, and where its record is: a bit per cell and the count of
 // set bits before each 64-bit word (rank), so a record is found in O(1) with 1.5 bits per cell.
@@ -189,7 +208,8 @@ struct TerrainTree::Impl {
   ContentIndex content_index;        // cells with content -> their record in `content`
   std::vector<CellContent> content;  // in cell id order
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
-  std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
+  // The kOutside slots (indices into slots) of each side.
+  std::array<std::vector<std::int32_t>, 4> outside;
   std::vector<glm::u8vec4> merged_colors;
   std::vector<glm::vec2> merged_tcoords;  // one per merged vertex while has_tcoords, else empty
   bool has_tcoords = false;               // some surface has texture coordinates
@@ -230,6 +250,10 @@ struct TerrainTree::Impl {
   // (di, dj) when `window` is this one moved by di columns and dj rows (multiples of the
   // level-0 cell size, less than the window) over the same terrain; nothing otherwise.
   std::optional<std::pair<int, int>> shift_of(const TerrainWindow& window) const;
+  // The plane offset where outside band `band` of `side` ends toward the window (band 0: the
+  // boundary plane itself) and its width (a level-0 cell's), along x for west and east, y for
+  // south and north.
+  double band_plane(int side, int band) const;
   // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
   // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the
   // triangles reaching beyond the overlap merged into the rest of the window.
