@@ -48,6 +48,8 @@ struct FlyOptions {
   std::optional<double> threshold, start, end;
   int crf = 20;
   int samples = 1;
+  scene::Engine engine = scene::Engine::kVtk;  // --renderer
+  int aa = 8;                                  // --aa, with the tiler
   bool resume = false, force = false;
   std::vector<std::string> objects;  // --object, added to the scene's
 };
@@ -136,7 +138,17 @@ void run_fly(const FlyOptions& o) {
   const double threshold_scale = traversal.metric == mrbsp::LodMetric::kError ? factor : factor * factor;
   const double default_fov = scene.camera ? scene.camera->fov_y_deg : 45.0;
 
-  render::require_x_display("fly");
+  const bool tiled = o.engine == scene::Engine::kTiler;
+  if (tiled && (width * o.aa > 16384 || height * o.aa > 16384)) {
+    throw std::invalid_argument("--size " + std::to_string(width) + "x" + std::to_string(height) + " at --aa " +
+                                std::to_string(o.aa) + ": at most 16384 samples per side (" + std::to_string(16384 / o.aa) +
+                                " pixels)");
+  }
+  if (tiled && st.order != scene::DrawOrder::kBsp) {
+    throw std::invalid_argument(source + ": scene: \"order\": \"" + scene::order_name(st.order) +
+                                "\": --renderer tiler draws in the tree's own order (bsp)");
+  }
+  if (!tiled) render::require_x_display("fly");
   // Outputs: nothing is replaced without --force; a PNG folder resumes only what it started.
   if (!o.stats.empty() && !o.force && std::filesystem::exists(o.stats)) {
     throw std::runtime_error(o.stats.string() + ": exists (use --force to overwrite)");
@@ -148,6 +160,10 @@ void run_fly(const FlyOptions& o) {
                    {"fps", o.fps},
                    {"threshold", default_threshold},
                    {"samples", o.samples}};
+  if (tiled) {  // frames of another renderer or sampling are other frames (absent: VTK, as before)
+    manifest["renderer"] = scene::engine_name(o.engine);
+    manifest["aa"] = o.aa;
+  }
   if (video) {
     if (o.resume) throw std::invalid_argument("--resume: only a PNG folder export resumes; a video is written whole");
     if (!o.force && std::filesystem::exists(o.output)) {
@@ -225,7 +241,10 @@ void run_fly(const FlyOptions& o) {
   render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
   settings.height = height * factor;
-  render::SceneRenderer renderer(std::move(mosaic), scene, settings, render::scene_options(st));
+  render::SceneOptions scene_opts = render::scene_options(st);
+  scene_opts.engine = o.engine;
+  scene_opts.tiler.aa = o.aa;
+  render::SceneRenderer renderer(std::move(mosaic), scene, settings, scene_opts);
 
   const scene::CameraPath path(
       file.keys, renderer.frame(), [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); },
@@ -324,10 +343,11 @@ void run_fly(const FlyOptions& o) {
 
 void add_fly_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("fly", "Export a scripted flythrough (camera path JSON) to a video or PNG frames "
-                                        "(needs an X display; docs/camera-paths.md)");
+                                        "(VTK needs an X display, --renderer tiler does not; docs/camera-paths.md)");
   auto o = std::make_shared<FlyOptions>();
   struct Raw {
     double threshold = 0, start = 0, end = 0;
+    std::string renderer = "vtk", aa = "8";
   };
   auto raw = std::make_shared<Raw>();
   cmd->add_option("path", o->path, "Camera path file (JSON)")->required();
@@ -347,11 +367,26 @@ void add_fly_command(CLI::App& app) {
                   "Antialiasing: samples per pixel, 1, 4, 9 or 16 (supersampling: rendered at 1x, 2x, 3x or 4x "
                   "the size and box-filtered down)")
       ->capture_default_str();
-  cmd->callback([o, raw, threshold, start, end] {
+  cmd->add_option("--renderer", raw->renderer,
+                  "vtk (OpenGL through VTK, needs an X display) or tiler (software: the tree's front-to-back order "
+                  "tiled into a coverage pyramid, antialiased by --aa)")
+      ->capture_default_str();
+  auto* aa = cmd->add_option("--aa", raw->aa, "With --renderer tiler: samples per pixel per axis, 1, 2, 4 or 8")
+                 ->capture_default_str();
+  cmd->callback([o, raw, threshold, start, end, aa] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
     if (o->samples != 1 && o->samples != 4 && o->samples != 9 && o->samples != 16) {
       throw std::invalid_argument("--samples " + std::to_string(o->samples) + ": must be 1, 4, 9 or 16");
+    }
+    o->engine = scene::parse_engine(raw->renderer);
+    o->aa = scene::parse_aa(raw->aa);
+    if (o->engine == scene::Engine::kTiler && o->samples != 1) {
+      throw std::invalid_argument("--samples " + std::to_string(o->samples) +
+                                  ": VTK's supersampling; --renderer tiler antialiases with --aa");
+    }
+    if (o->engine == scene::Engine::kVtk && aa->count() > 0) {
+      throw std::invalid_argument("--aa: needs --renderer tiler (VTK's antialiasing is --samples)");
     }
     if (o->resume && o->force) throw std::invalid_argument("--resume and --force: give one (continue, or start over)");
     if (threshold->count() > 0) {
