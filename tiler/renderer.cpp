@@ -47,9 +47,14 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <glm/geometric.hpp>
 
@@ -75,24 +80,24 @@ int popcount(std::uint64_t x) {
 
 // Masks of a pixel's samples in the 8x8 layout of a tile: sample (sx, sy) is bit sy * 8 + sx,
 // the aa x aa samples of a pixel at the low corner (bits outside it are 0).
-constexpr std::uint64_t kRow = 0x0101010101010101ull;
 constexpr std::uint64_t rect_mask(int x0, int w, int y0, int h) {
   const std::uint64_t cols = ((std::uint64_t{1} << w) - 1) << x0;
   std::uint64_t m = 0;
   for (int r = y0; r < y0 + h; ++r) m |= cols << (8 * r);
   return m;
 }
-// Samples whose x (y) has bit k set, for centroids: sum of x over a mask = sum_k 2^k popcount(m & X[k]).
+// Samples whose x (y) has bit k set, for centroids: the sum of x over a mask is
+// sum_k 2^k popcount(m & X_k).
 constexpr std::uint64_t kX1 = 0xAAAAAAAAAAAAAAAAull, kX2 = 0xCCCCCCCCCCCCCCCCull, kX4 = 0xF0F0F0F0F0F0F0F0ull;
 constexpr std::uint64_t kY1 = 0xFF00FF00FF00FF00ull, kY2 = 0xFFFF0000FFFF0000ull, kY4 = 0xFFFFFFFF00000000ull;
-static_assert(kRow * 0xFF == ~std::uint64_t{0});
 
-// The centroid of a non-empty mask's samples, in samples from the pixel's low corner (centres
-// at +0.5).
-glm::dvec2 centroid(std::uint64_t m, int count) {
+// The centroid of a non-empty mask's samples, in samples from the pixel's low corner (sample
+// centres at +0.5).
+glm::vec2 centroid(std::uint64_t m, int count) {
   const int sx = popcount(m & kX1) + 2 * popcount(m & kX2) + 4 * popcount(m & kX4);
   const int sy = popcount(m & kY1) + 2 * popcount(m & kY2) + 4 * popcount(m & kY4);
-  return {static_cast<double>(sx) / count + 0.5, static_cast<double>(sy) / count + 0.5};
+  const float inv = 1.0f / static_cast<float>(count);
+  return {static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f};
 }
 
 int pow2_at_least(double v, int cap) {
@@ -101,98 +106,10 @@ int pow2_at_least(double v, int cap) {
   return k;
 }
 
-// An affine function of window position (output pixels from the bottom-left corner).
-struct Plane {
-  double a = 0, b = 0, c = 0;
-  double at(double x, double y) const { return a * x + b * y + c; }
-};
-
 // Eye space: x right, y up, z the depth along the view axis (GL's clip w).
 struct Eye {
   double x, y, z;
 };
-
-enum class Kind : std::uint8_t { kTextured, kWall, kMerged };
-
-// What a triangle is shaded with: attributes interpolated perspective-correctly by the
-// homogeneous barycentrics of the pixel ray (Olano and Greer 1997): with the vertices' eye
-// positions V0, V1, V2 and the ray direction D(x, y) = ((x - w/2) / f, (y - h/2) / f, 1), the
-// barycentrics are e_i / (e_0 + e_1 + e_2) for e_i = (V_j x V_k) . D, affine in (x, y); an
-// attribute is then (sum A_i e_i) / (sum e_i), the quotient of two planes. No division by the
-// determinant and no clipping is needed for it.
-struct Shade {
-  Kind kind = Kind::kTextured;
-  bool translucent = false;
-  int kx = 1, ky = 1;       // shading blocks per pixel along x and y (textured)
-  Plane s;                  // sum e_i
-  std::array<Plane, 5> n;   // textured: u, v (texels), haze; wall: haze; merged: r, g, b, a (0..255), haze
-};
-
-struct Class {
-  std::uint64_t mask;  // open samples with this transmittance
-  float t;
-  std::int32_t next;
-};
-
-}  // namespace
-
-struct Renderer::Impl {
-  // Per band and thread: the band's pyramid (one per band height: the last band may be
-  // shorter), the pyramid's reports, transmittance classes, polygon scratch, counters.
-  struct BandState {
-    std::vector<std::unique_ptr<coverage::Pyramid>> pyramids;
-    std::vector<coverage::TileMask> records;
-    std::vector<Class> classes;
-    std::vector<glm::dvec2> poly;
-    Stats stats;
-    coverage::Pyramid& pyramid(int w, int h) {
-      for (auto& p : pyramids)
-        if (p->width() == w && p->height() == h) {
-          p->clear();
-          return *p;
-        }
-      pyramids.push_back(std::make_unique<coverage::Pyramid>(w, h));
-      return *pyramids.back();
-    }
-  };
-  tbb::enumerable_thread_specific<BandState> states;
-  // Per triangle of the frame: the bands its projection reaches (first > last: none).
-  std::vector<std::int32_t> band_first, band_last;
-  std::vector<std::uint32_t> band_start, band_items;  // triangles of band b: items [start[b], start[b+1])
-  // Per pixel, rows from the bottom: the accumulated colour (sum over samples, 0..255), the
-  // uniform transmittance, the head of the transmittance classes (-1: uniform), shaded samples.
-  std::vector<float> acc, uniform_t;
-  std::vector<std::int32_t> head;
-  std::vector<std::uint8_t> counts;
-};
-
-Renderer::Renderer(const Settings& settings) : settings_(settings), impl_(std::make_unique<Impl>()) {
-  const Settings& s = settings;
-  if (s.aa != 1 && s.aa != 2 && s.aa != 4 && s.aa != 8) {
-    throw std::invalid_argument("tiler::Renderer: aa " + std::to_string(s.aa) + " is not 1, 2, 4 or 8");
-  }
-  const int limit = coverage::kMaxViewport / s.aa;
-  if (s.width < 1 || s.height < 1 || s.width > limit || s.height > limit) {
-    throw std::invalid_argument("tiler::Renderer: " + std::to_string(s.width) + "x" + std::to_string(s.height) +
-                                " outside 1.." + std::to_string(limit) + " pixels per side at aa " + std::to_string(s.aa));
-  }
-  if (!(s.texel_rate >= 0.0) || !std::isfinite(s.texel_rate)) {
-    throw std::invalid_argument("tiler::Renderer: texel_rate must be a finite number >= 0");
-  }
-  if (s.band_rows < 1) throw std::invalid_argument("tiler::Renderer: band_rows must be >= 1");
-  if (s.threads < 0) throw std::invalid_argument("tiler::Renderer: threads must be >= 0");
-  const std::size_t pixels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
-  rgb_.assign(pixels * 3, 0);
-  counts_.assign(pixels, 0);
-  impl_->acc.assign(pixels * 3, 0.0f);
-  impl_->uniform_t.assign(pixels, 1.0f);
-  impl_->head.assign(pixels, -1);
-  impl_->counts.assign(pixels, 0);
-}
-
-Renderer::~Renderer() = default;
-
-namespace {
 
 // The view as GL sees it (vtkCamera from mrbsp::Camera: app/render/vtk_camera.h).
 struct View {
@@ -228,7 +145,7 @@ int window_polygon(const View& v, const std::array<Eye, 3>& tri, std::array<glm:
   }
   clipped = outside_any != 0;
   if (!clipped) {
-    for (int i = 0; i < 3; ++i) out[static_cast<std::size_t>(i)] = v.window(tri[static_cast<std::size_t>(i)]);
+    for (std::size_t i = 0; i < 3; ++i) out[i] = v.window(tri[i]);
     return 3;
   }
   // Sutherland-Hodgman in eye space, plane by plane.
@@ -237,27 +154,26 @@ int window_polygon(const View& v, const std::array<Eye, 3>& tri, std::array<glm:
   std::copy(tri.begin(), tri.end(), a.begin());
   for (int k = 0; k < 6; ++k) {
     if (!(outside_any & (1 << k))) continue;
-    int m = 0;
+    std::size_t m = 0;
     for (int i = 0; i < n; ++i) {
       const Eye& p = a[static_cast<std::size_t>(i)];
       const Eye& q = a[static_cast<std::size_t>((i + 1) % n)];
       const double dp = v.plane(k, p), dq = v.plane(k, q);
-      if (dp >= 0) b[static_cast<std::size_t>(m++)] = p;
+      if (dp >= 0) b[m++] = p;
       if ((dp >= 0) != (dq >= 0)) {
         // From the inside end, so that both triangles of a shared edge get the same point.
         const Eye& in = dp >= 0 ? p : q;
         const Eye& out_end = dp >= 0 ? q : p;
-        const double di = dp >= 0 ? dp : dq, d_out = dp >= 0 ? dq : dp;
-        const double t = di / (di - d_out);
-        b[static_cast<std::size_t>(m++)] = {in.x + (out_end.x - in.x) * t, in.y + (out_end.y - in.y) * t,
-                                            in.z + (out_end.z - in.z) * t};
+        const double d_in = dp >= 0 ? dp : dq, d_out = dp >= 0 ? dq : dp;
+        const double t = d_in / (d_in - d_out);
+        b[m++] = {in.x + (out_end.x - in.x) * t, in.y + (out_end.y - in.y) * t, in.z + (out_end.z - in.z) * t};
       }
     }
-    n = m;
+    n = static_cast<int>(m);
     if (n < 3) return 0;
     std::swap(a, b);
   }
-  for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = v.window(a[static_cast<std::size_t>(i)]);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) out[i] = v.window(a[i]);
   return n;
 }
 
@@ -265,23 +181,388 @@ std::array<Eye, 3> eye_triangle(const View& v, std::span<const glm::vec3> positi
   return {v.to_eye(positions[idx[0]]), v.to_eye(positions[idx[1]]), v.to_eye(positions[idx[2]])};
 }
 
-// Bilinear lookup of the lattice texture at texel coordinates (u, v) (texel centres at whole
-// numbers), clamped to the edge: GL's LINEAR filter with CLAMP_TO_EDGE.
-glm::dvec3 texel(std::span<const std::uint8_t> tex, int side, double u, double v) {
-  const double hi = side - 1;
-  u = std::clamp(u, 0.0, hi);
-  v = std::clamp(v, 0.0, hi);
-  const int i0 = std::min(static_cast<int>(u), side - 2 < 0 ? 0 : side - 2);
-  const int j0 = std::min(static_cast<int>(v), side - 2 < 0 ? 0 : side - 2);
-  const double fu = u - i0, fv = v - j0;
-  const int i1 = std::min(i0 + 1, side - 1), j1 = std::min(j0 + 1, side - 1);
-  const auto at = [&](int i, int j) {
-    const std::uint8_t* c = &tex[4 * (static_cast<std::size_t>(j) * static_cast<std::size_t>(side) + static_cast<std::size_t>(i))];
-    return glm::dvec3(c[0], c[1], c[2]);
+enum class Kind : std::uint8_t { kTextured, kWall, kMerged };
+
+// A colour, 0..255 per channel (r, g, b; the fourth lane unused): one SSE2 register where there
+// is SSE2 (every x86-64), four floats otherwise.
+#if defined(__SSE2__)
+struct Color {
+  __m128 v;
+  Color() : v(_mm_setzero_ps()) {}
+  explicit Color(__m128 x) : v(x) {}
+  Color(float r, float g, float b) : v(_mm_set_ps(0.0f, b, g, r)) {}
+  friend Color operator+(Color a, Color b) { return Color(_mm_add_ps(a.v, b.v)); }
+  friend Color operator-(Color a, Color b) { return Color(_mm_sub_ps(a.v, b.v)); }
+  friend Color operator*(Color a, float s) { return Color(_mm_mul_ps(a.v, _mm_set1_ps(s))); }
+  Color& operator+=(Color b) { return *this = *this + b; }
+  std::array<float, 4> lanes() const {
+    std::array<float, 4> f;
+    _mm_storeu_ps(f.data(), v);
+    return f;
+  }
+  // The RGBA bytes at p, as floats.
+  static Color bytes(const std::uint8_t* p) {
+    std::int32_t word;
+    std::memcpy(&word, p, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i x = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
+    return Color(_mm_cvtepi32_ps(x));
+  }
+};
+#else
+struct Color {
+  std::array<float, 4> c{0, 0, 0, 0};
+  Color() = default;
+  Color(float r, float g, float b) : c{r, g, b, 0.0f} {}
+  friend Color operator+(Color a, Color b) {
+    for (std::size_t k = 0; k < 4; ++k) a.c[k] += b.c[k];
+    return a;
+  }
+  friend Color operator-(Color a, Color b) {
+    for (std::size_t k = 0; k < 4; ++k) a.c[k] -= b.c[k];
+    return a;
+  }
+  friend Color operator*(Color a, float s) {
+    for (float& x : a.c) x *= s;
+    return a;
+  }
+  Color& operator+=(Color b) { return *this = *this + b; }
+  std::array<float, 4> lanes() const { return c; }
+  static Color bytes(const std::uint8_t* p) { return Color(p[0], p[1], p[2]); }
+};
+#endif
+
+// An affine function of window position, about the triangle's centre: at + a dx + b dy.
+struct Plane {
+  float a = 0, b = 0, at = 0;
+  float operator()(float dx, float dy) const { return at + a * dx + b * dy; }
+};
+
+// What a triangle is shaded with. Attributes are interpolated perspective-correctly by the
+// homogeneous barycentrics of the pixel ray (Olano and Greer 1997): with the vertices' eye
+// positions V0, V1, V2 and the ray direction D(x, y) = ((x - w/2) / f, (y - h/2) / f, 1), the
+// barycentrics are e_i / (e_0 + e_1 + e_2) for e_i = (V_j x V_k) . D, affine in (x, y); an
+// attribute is then (sum A_i e_i) / (sum e_i), the quotient of two planes: no clipping and no
+// determinant needed. The planes are set up in double precision about the triangle's centre
+// (x0, y0), scaled so that the denominator is 1 there, and evaluated in float.
+struct Shade {
+  Kind kind = Kind::kTextured;
+  bool translucent = false;
+  int kx = 1, ky = 1;        // shading blocks per pixel along x and y (textured)
+  float x0 = 0, y0 = 0;
+  Plane s;                   // sum e_i
+  std::array<Plane, 5> n;    // textured: u, v (texels), haze; wall: haze; merged: r, g, b, a (0..255), haze
+};
+
+// The lattice texture: bilinear between texel centres (whole texel coordinates), clamped to the
+// edge (GL's LINEAR filter with CLAMP_TO_EDGE).
+struct Texture {
+  const std::uint8_t* rgba = nullptr;
+  int side = 0;
+  Color at(float u, float v) const {
+    const float hi = static_cast<float>(side - 1);
+    u = std::clamp(u, 0.0f, hi);
+    v = std::clamp(v, 0.0f, hi);
+    const int i0 = std::min(static_cast<int>(u), std::max(side - 2, 0));
+    const int j0 = std::min(static_cast<int>(v), std::max(side - 2, 0));
+    const float fu = u - static_cast<float>(i0), fv = v - static_cast<float>(j0);
+    const std::size_t step = side > 1 ? 4 : 0, row = step * static_cast<std::size_t>(side);
+    const std::uint8_t* p = rgba + 4 * (static_cast<std::size_t>(j0) * static_cast<std::size_t>(side) + static_cast<std::size_t>(i0));
+    const Color c00 = Color::bytes(p), c10 = Color::bytes(p + step);
+    const Color c01 = Color::bytes(p + row), c11 = Color::bytes(p + row + step);
+    const Color b = c00 + (c10 - c00) * fu, t = c01 + (c11 - c01) * fu;
+    return b + (t - b) * fv;
+  }
+};
+
+// The colour (0..255) and opacity of a triangle at window point (x, y).
+struct Shader {
+  Texture texture;
+  Color wall;
+  Color haze;
+  bool hazy = false;
+  Color operator()(const Shade& sh, float x, float y, float& alpha) const {
+    const float dx = x - sh.x0, dy = y - sh.y0;
+    float S = sh.s(dx, dy);
+    if (!(S != 0.0f) || !std::isfinite(S)) S = 1.0f;  // a triangle seen edge-on: any point of it
+    const float inv = 1.0f / S;
+    Color c;
+    float h = 0;
+    alpha = 1.0f;
+    switch (sh.kind) {
+      case Kind::kTextured:
+        c = texture.at(sh.n[0](dx, dy) * inv, sh.n[1](dx, dy) * inv);
+        h = sh.n[2](dx, dy) * inv;
+        break;
+      case Kind::kWall:
+        c = wall;
+        h = sh.n[0](dx, dy) * inv;
+        break;
+      case Kind::kMerged:
+        c = Color(sh.n[0](dx, dy), sh.n[1](dx, dy), sh.n[2](dx, dy)) * inv;
+        alpha = std::clamp(sh.n[3](dx, dy) * inv * (1.0f / 255.0f), 0.0f, 1.0f);
+        h = sh.n[4](dx, dy) * inv;
+        break;
+    }
+    if (hazy) c += (haze - c) * h;
+    return c;
+  }
+};
+
+struct Class {
+  std::uint64_t mask;  // open samples with this transmittance
+  float t;
+  std::int32_t next;
+};
+
+}  // namespace
+
+struct Renderer::Impl {
+  // Per band and thread: the band's pyramid (one per band height: the last band may be
+  // shorter), the pyramid's reports, transmittance classes, polygon scratch, counters.
+  struct BandState {
+    std::vector<std::unique_ptr<coverage::Pyramid>> pyramids;
+    std::vector<coverage::TileMask> records;
+    std::vector<Class> classes;
+    std::vector<glm::dvec2> poly;
+    Stats stats;
+    coverage::Pyramid& pyramid(int w, int h) {
+      for (auto& p : pyramids)
+        if (p->width() == w && p->height() == h) {
+          p->clear();
+          return *p;
+        }
+      pyramids.push_back(std::make_unique<coverage::Pyramid>(w, h));
+      return *pyramids.back();
+    }
   };
-  const glm::dvec3 bottom = at(i0, j0) + (at(i1, j0) - at(i0, j0)) * fu;
-  const glm::dvec3 top = at(i0, j1) + (at(i1, j1) - at(i0, j1)) * fu;
-  return bottom + (top - bottom) * fv;
+  tbb::enumerable_thread_specific<BandState> states;
+  // Per triangle of the frame: the bands its projection reaches (first > last: none).
+  std::vector<std::int32_t> band_first, band_last;
+  std::vector<std::uint32_t> band_start, band_items;  // triangles of band b: items [start[b], start[b+1])
+  // Per pixel, rows from the bottom: the accumulated colour (sum over samples, 0..255), the
+  // uniform transmittance, the head of the transmittance classes (-1: uniform), shaded samples.
+  std::vector<Color> acc;
+  std::vector<float> uniform_t;
+  std::vector<std::int32_t> head;
+  std::vector<std::uint8_t> counts;
+};
+
+namespace {
+
+// A band's pixels being accumulated: the colour sums, transmittance and sample counts of the
+// pixels of one band (rows from the bottom), and its transmittance classes.
+struct Accumulator {
+  Color* acc;
+  float* uniform_t;
+  std::int32_t* head;
+  std::uint8_t* counts;
+  std::vector<Class>& classes;
+  Stats& stats;
+  std::uint64_t full;  // a pixel's samples
+
+  // Adds colour c times weight to pixel p for the samples of mask (all open), each weighted by
+  // its transmittance.
+  void add(std::size_t p, std::uint64_t mask, int count, Color c, float weight) {
+    float w = 0;
+    const std::int32_t h0 = head[p];
+    if (h0 < 0) {
+      w = static_cast<float>(count) * uniform_t[p];
+    } else {
+      for (std::int32_t k = h0; k >= 0; k = classes[static_cast<std::size_t>(k)].next) {
+        const Class& cl = classes[static_cast<std::size_t>(k)];
+        const std::uint64_t i = cl.mask & mask;
+        if (i) w += static_cast<float>(popcount(i)) * cl.t;
+      }
+    }
+    acc[p] += c * (w * weight);
+  }
+
+  // An opaque fragment's newly covered samples: shaded once or block by block.
+  void opaque(std::size_t p, std::uint64_t mask, int count, Color c) {
+    counts[p] = static_cast<std::uint8_t>(counts[p] + count);
+    stats.samples_covered += static_cast<std::uint64_t>(count);
+    add(p, mask, count, c, 1.0f);
+  }
+
+  // A translucent fragment: colour c with opacity alpha over the samples of mask (all open);
+  // the pixel's covered samples are `covered`.
+  void translucent(std::size_t p, std::uint64_t mask, int count, std::uint64_t covered, Color c, float alpha) {
+    add(p, mask, count, c, alpha);
+    const float keep = 1.0f - alpha;
+    std::int32_t& h0 = head[p];
+    if (h0 < 0) {
+      const std::uint64_t rest = full & ~mask & ~covered;
+      if (!rest) {
+        uniform_t[p] *= keep;
+        return;
+      }
+      const float t = uniform_t[p];
+      classes.push_back({rest, t, -1});
+      classes.push_back({mask, t * keep, static_cast<std::int32_t>(classes.size()) - 1});
+      h0 = static_cast<std::int32_t>(classes.size()) - 1;
+      ++stats.class_splits;
+      return;
+    }
+    for (std::int32_t k = h0; k >= 0;) {
+      Class& cl = classes[static_cast<std::size_t>(k)];
+      const std::int32_t next = cl.next;
+      const std::uint64_t i = cl.mask & mask;
+      if (i) {
+        const std::uint64_t rest = cl.mask & ~mask & ~covered;
+        if (!rest) {
+          cl.mask = i;
+          cl.t *= keep;
+        } else {
+          cl.mask = rest;
+          const float t = cl.t * keep;
+          classes.push_back({i, t, h0});  // at the head: not met again in this loop
+          h0 = static_cast<std::int32_t>(classes.size()) - 1;
+          ++stats.class_splits;
+        }
+      }
+      k = next;
+    }
+    // Classes of equal transmittance join (the two triangles of a translucent quad split the
+    // pixels on their shared edge, and the second one makes the halves equal again), classes
+    // of covered samples go, and one class left is the uniform case again.
+    const std::uint64_t open = full & ~covered;
+    std::int32_t* link = &h0;
+    while (*link >= 0) {
+      Class& cl = classes[static_cast<std::size_t>(*link)];
+      cl.mask &= open;
+      if (!cl.mask) {
+        *link = cl.next;
+        continue;
+      }
+      for (std::int32_t* other = &cl.next; *other >= 0;) {
+        Class& o = classes[static_cast<std::size_t>(*other)];
+        if (o.t == cl.t) {
+          cl.mask |= o.mask & open;
+          *other = o.next;
+        } else {
+          other = &o.next;
+        }
+      }
+      link = &cl.next;
+    }
+    // (mask is open and not empty, so some class is left.)
+    if (classes[static_cast<std::size_t>(h0)].next < 0) {
+      uniform_t[p] = classes[static_cast<std::size_t>(h0)].t;
+      h0 = -1;
+    }
+  }
+};
+
+}  // namespace
+
+Renderer::Renderer(const Settings& settings) : settings_(settings), impl_(std::make_unique<Impl>()) {
+  const Settings& s = settings;
+  if (s.aa != 1 && s.aa != 2 && s.aa != 4 && s.aa != 8) {
+    throw std::invalid_argument("tiler::Renderer: aa " + std::to_string(s.aa) + " is not 1, 2, 4 or 8");
+  }
+  const int limit = coverage::kMaxViewport / s.aa;
+  if (s.width < 1 || s.height < 1 || s.width > limit || s.height > limit) {
+    throw std::invalid_argument("tiler::Renderer: " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                                " outside 1.." + std::to_string(limit) + " pixels per side at aa " + std::to_string(s.aa));
+  }
+  if (!(s.texel_rate >= 0.0) || !std::isfinite(s.texel_rate)) {
+    throw std::invalid_argument("tiler::Renderer: texel_rate must be a finite number >= 0");
+  }
+  if (s.band_rows < 1) throw std::invalid_argument("tiler::Renderer: band_rows must be >= 1");
+  if (s.threads < 0) throw std::invalid_argument("tiler::Renderer: threads must be >= 0");
+  const std::size_t pixels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+  rgb_.assign(pixels * 3, 0);
+  counts_.assign(pixels, 0);
+  impl_->acc.assign(pixels, Color());
+  impl_->uniform_t.assign(pixels, 1.0f);
+  impl_->head.assign(pixels, -1);
+  impl_->counts.assign(pixels, 0);
+}
+
+Renderer::~Renderer() = default;
+
+namespace {
+
+// The shading of triangle idx (its eye-space vertices tri, its clipped window polygon poly).
+Shade setup_shade(const View& view, const SceneColors& colors, const Look& look, double texel_rate, int aa,
+                  const std::uint32_t* idx, const std::array<Eye, 3>& tri, const std::array<glm::dvec2, kMaxClipped>& poly,
+                  int n) {
+  const std::size_t side = static_cast<std::size_t>(colors.lattice_side), lattice = side * side;
+  Shade sh;
+  const std::uint32_t v0 = idx[0];
+  sh.kind = v0 < lattice ? Kind::kTextured : v0 < colors.merged_base ? Kind::kWall : Kind::kMerged;
+  std::array<double, 3> haze{0, 0, 0};
+  if (look.haze_distance > 0.0) {
+    for (std::size_t i = 0; i < 3; ++i) haze[i] = 0.85 * (1.0 - std::exp(-tri[i].z / look.haze_distance));
+  }
+  std::array<std::array<double, 5>, 3> attr{};  // per vertex
+  std::size_t n_attr = 0;
+  if (sh.kind == Kind::kTextured) {
+    n_attr = 3;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t v = idx[i];
+      const bool on = v < lattice;  // (a textured triangle has lattice vertices only)
+      attr[i] = {on ? static_cast<double>(v % side) : 0.0, on ? static_cast<double>(v / side) : 0.0, haze[i], 0, 0};
+    }
+  } else if (sh.kind == Kind::kWall) {
+    n_attr = 1;
+    for (std::size_t i = 0; i < 3; ++i) attr[i][0] = haze[i];
+  } else {
+    n_attr = 5;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t v = idx[i];
+      const glm::u8vec4 c = v >= colors.merged_base ? colors.merged_colors[v - colors.merged_base] : colors.wall_color;
+      attr[i] = {static_cast<double>(c.r), static_cast<double>(c.g), static_cast<double>(c.b), static_cast<double>(c.a), haze[i]};
+      sh.translucent = sh.translucent || c.a < 255;
+    }
+  }
+  // The centre: the polygon's vertex mean.
+  glm::dvec2 centre(0.0);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) centre += poly[i];
+  centre /= static_cast<double>(n);
+  // e_i = (V_j x V_k) . D, D = ((x - hw) / f, (y - hh) / f, 1): gradient and value at the centre.
+  struct Affine {
+    double a = 0, b = 0, at = 0;
+  };
+  Affine s;
+  std::array<Affine, 5> num;
+  const double dx = (centre.x - view.hw) / view.focal, dy = (centre.y - view.hh) / view.focal;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Eye& a = tri[(i + 1) % 3];
+    const Eye& b = tri[(i + 2) % 3];
+    const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
+    const Affine e{cx / view.focal, cy / view.focal, cx * dx + cy * dy + cz};
+    s.a += e.a;
+    s.b += e.b;
+    s.at += e.at;
+    for (std::size_t k = 0; k < n_attr; ++k) {
+      num[k].a += attr[i][k] * e.a;
+      num[k].b += attr[i][k] * e.b;
+      num[k].at += attr[i][k] * e.at;
+    }
+  }
+  const double scale = s.at != 0.0 && std::isfinite(s.at) ? 1.0 / s.at : 1.0;
+  sh.x0 = static_cast<float>(centre.x);
+  sh.y0 = static_cast<float>(centre.y);
+  sh.s = {static_cast<float>(s.a * scale), static_cast<float>(s.b * scale), static_cast<float>(s.at * scale)};
+  for (std::size_t k = 0; k < n_attr; ++k) {
+    sh.n[k] = {static_cast<float>(num[k].a * scale), static_cast<float>(num[k].b * scale), static_cast<float>(num[k].at * scale)};
+  }
+  if (sh.kind == Kind::kTextured) {
+    if (texel_rate == 0.0) {
+      sh.kx = sh.ky = aa;
+    } else {
+      // The texels a pixel spans along x and y at the centre (the denominator is 1 there).
+      const double U = num[0].at * scale, V = num[1].at * scale;
+      const double sa = s.a * scale, sb = s.b * scale;
+      const double du_dx = num[0].a * scale - U * sa, dv_dx = num[1].a * scale - V * sa;
+      const double du_dy = num[0].b * scale - U * sb, dv_dy = num[1].b * scale - V * sb;
+      sh.kx = pow2_at_least(texel_rate * std::hypot(du_dx, dv_dx), aa);
+      sh.ky = pow2_at_least(texel_rate * std::hypot(du_dy, dv_dy), aa);
+    }
+  }
+  return sh;
 }
 
 }  // namespace
@@ -351,11 +632,11 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
         bool clipped = false;
         const int n = window_polygon(view, eye_triangle(view, colors.positions, &indices[3 * t]), poly, clipped);
         double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
-        for (int i = 0; i < n; ++i) {
-          x0 = std::min(x0, poly[static_cast<std::size_t>(i)].x);
-          x1 = std::max(x1, poly[static_cast<std::size_t>(i)].x);
-          y0 = std::min(y0, poly[static_cast<std::size_t>(i)].y);
-          y1 = std::max(y1, poly[static_cast<std::size_t>(i)].y);
+        for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+          x0 = std::min(x0, poly[i].x);
+          x1 = std::max(x1, poly[i].x);
+          y0 = std::min(y0, poly[i].y);
+          y1 = std::max(y1, poly[i].y);
         }
         if (n == 0 || x1 < 0 || x0 > W || y1 < 0 || y0 > H || !(x0 <= x1) || !(y0 <= y1)) {
           m.band_first[t] = 1;
@@ -370,12 +651,12 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   m.band_start.assign(static_cast<std::size_t>(bands) + 1, 0);
   for (std::size_t t = 0; t < n_tri; ++t)
     for (int b = m.band_first[t]; b <= m.band_last[t]; ++b) ++m.band_start[static_cast<std::size_t>(b) + 1];
-  for (int b = 0; b < bands; ++b) m.band_start[static_cast<std::size_t>(b) + 1] += m.band_start[static_cast<std::size_t>(b)];
+  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b) m.band_start[b + 1] += m.band_start[b];
   m.band_items.resize(m.band_start.back());
   {
-    std::vector<std::uint32_t> fill(m.band_start.begin(), m.band_start.end() - 1);
+    std::vector<std::uint32_t> next(m.band_start.begin(), m.band_start.end() - 1);
     for (std::size_t t = 0; t < n_tri; ++t)
-      for (int b = m.band_first[t]; b <= m.band_last[t]; ++b) m.band_items[fill[static_cast<std::size_t>(b)]++] = static_cast<std::uint32_t>(t);
+      for (int b = m.band_first[t]; b <= m.band_last[t]; ++b) m.band_items[next[static_cast<std::size_t>(b)]++] = static_cast<std::uint32_t>(t);
   }
   const double setup_ms = ms_since(t_start);
   const auto t_tile = Clock::now();
@@ -383,9 +664,12 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   const int N = aa * aa;
   const std::uint64_t full = rect_mask(0, aa, 0, aa);
   const int per_tile = 8 / aa;  // pixels per tile side
-  const double inv_aa = 1.0 / aa;
-  const glm::dvec3 haze_color = look.haze_color;
-  const bool hazy = look.haze_distance > 0.0;
+  const float inv_aa = 1.0f / static_cast<float>(aa);
+  Shader shader;
+  shader.texture = {colors.texture.data(), static_cast<int>(side)};
+  shader.wall = Color(colors.wall_color.r, colors.wall_color.g, colors.wall_color.b);
+  shader.haze = Color(static_cast<float>(look.haze_color.r), static_cast<float>(look.haze_color.g), static_cast<float>(look.haze_color.b));
+  shader.hazy = look.haze_distance > 0.0;
 
   // One band: its triangles tiled into its own pyramid, front to back, then the sky.
   const auto draw_band = [&](int band) {
@@ -393,186 +677,32 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     const int row0 = band * R, rows = std::min(R, H - row0);
     coverage::Pyramid& pyramid = st.pyramid(W * aa, rows * aa);
     st.classes.clear();
-    for (int y = row0; y < row0 + rows; ++y) {
-      const std::size_t p0 = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
-      std::fill_n(m.acc.begin() + static_cast<std::ptrdiff_t>(3 * p0), 3 * W, 0.0f);
-      std::fill_n(m.uniform_t.begin() + static_cast<std::ptrdiff_t>(p0), W, 1.0f);
-      std::fill_n(m.head.begin() + static_cast<std::ptrdiff_t>(p0), W, -1);
-      std::fill_n(m.counts.begin() + static_cast<std::ptrdiff_t>(p0), W, std::uint8_t{0});
-    }
-    // Adds colour c to pixel p for the samples of mask, weighted by their transmittance.
-    const auto add = [&](std::size_t p, std::uint64_t mask, const glm::dvec3& c, double weight) {
-      double w = 0;
-      const std::int32_t h0 = m.head[p];
-      if (h0 < 0) {
-        w = popcount(mask) * static_cast<double>(m.uniform_t[p]);
-      } else {
-        for (std::int32_t k = h0; k >= 0; k = st.classes[static_cast<std::size_t>(k)].next) {
-          const Class& cl = st.classes[static_cast<std::size_t>(k)];
-          const std::uint64_t i = cl.mask & mask;
-          if (i) w += popcount(i) * static_cast<double>(cl.t);
-        }
-      }
-      w *= weight;
-      float* a = &m.acc[3 * p];
-      a[0] += static_cast<float>(c.r * w);
-      a[1] += static_cast<float>(c.g * w);
-      a[2] += static_cast<float>(c.b * w);
-    };
-    // A translucent fragment: colour c with opacity alpha over the samples of mask (all open),
-    // the pixel's covered samples `covered`.
-    const auto add_translucent = [&](std::size_t p, std::uint64_t mask, std::uint64_t covered, const glm::dvec3& c,
-                                     double alpha) {
-      add(p, mask, c, alpha);
-      const auto keep = static_cast<float>(1.0 - alpha);
-      std::int32_t& h0 = m.head[p];
-      if (h0 < 0) {
-        const std::uint64_t rest = full & ~mask & ~covered;
-        if (!rest) {
-          m.uniform_t[p] *= keep;
-          return;
-        }
-        const float t = m.uniform_t[p];
-        st.classes.push_back({rest, t, -1});
-        st.classes.push_back({mask, t * keep, static_cast<std::int32_t>(st.classes.size()) - 1});
-        h0 = static_cast<std::int32_t>(st.classes.size()) - 1;
-        ++st.stats.class_splits;
-        return;
-      }
-      for (std::int32_t k = h0; k >= 0;) {
-        Class& cl = st.classes[static_cast<std::size_t>(k)];
-        const std::int32_t next = cl.next;
-        const std::uint64_t i = cl.mask & mask;
-        if (i) {
-          const std::uint64_t rest = cl.mask & ~mask & ~covered;
-          if (!rest) {
-            cl.mask = i;
-            cl.t *= keep;
-          } else {
-            cl.mask = rest;
-            const float t = cl.t * keep;
-            st.classes.push_back({i, t, h0});  // at the head: not met again in this loop
-            h0 = static_cast<std::int32_t>(st.classes.size()) - 1;
-            ++st.stats.class_splits;
-          }
-        }
-        k = next;
-      }
-      // Classes of equal transmittance join (the two triangles of a translucent quad split the
-      // pixels on their shared edge, and the second one makes the halves equal again), classes
-      // of covered samples go, and one class left is the uniform case again.
-      const std::uint64_t open = full & ~covered;
-      std::int32_t* link = &h0;
-      while (*link >= 0) {
-        Class& cl = st.classes[static_cast<std::size_t>(*link)];
-        cl.mask &= open;
-        if (!cl.mask) {
-          *link = cl.next;
-          continue;
-        }
-        for (std::int32_t* other = &cl.next; *other >= 0;) {
-          Class& o = st.classes[static_cast<std::size_t>(*other)];
-          if (o.t == cl.t) {
-            cl.mask |= o.mask & open;
-            *other = o.next;
-          } else {
-            other = &o.next;
-          }
-        }
-        link = &cl.next;
-      }
-      // (mask is open and not empty, so some class is left.)
-      if (st.classes[static_cast<std::size_t>(h0)].next < 0) {
-        m.uniform_t[p] = st.classes[static_cast<std::size_t>(h0)].t;
-        h0 = -1;
-      }
-    };
+    const std::size_t first = static_cast<std::size_t>(row0) * static_cast<std::size_t>(W);
+    const std::size_t count = static_cast<std::size_t>(rows) * static_cast<std::size_t>(W);
+    std::fill_n(m.acc.begin() + static_cast<std::ptrdiff_t>(first), count, Color());
+    std::fill_n(m.uniform_t.begin() + static_cast<std::ptrdiff_t>(first), count, 1.0f);
+    std::fill_n(m.head.begin() + static_cast<std::ptrdiff_t>(first), count, -1);
+    std::fill_n(m.counts.begin() + static_cast<std::ptrdiff_t>(first), count, std::uint8_t{0});
+    // Pixel p of the band: (x, y) with y counted from the band's first row.
+    Accumulator out{m.acc.data() + first, m.uniform_t.data() + first, m.head.data() + first, m.counts.data() + first,
+                    st.classes, st.stats, full};
 
-    const std::size_t begin = m.band_start[static_cast<std::size_t>(band)];
-    const std::size_t end = m.band_start[static_cast<std::size_t>(band) + 1];
     std::array<glm::dvec2, kMaxClipped> poly;
-    for (std::size_t item = begin; item < end; ++item) {
+    for (std::size_t item = m.band_start[static_cast<std::size_t>(band)]; item < m.band_start[static_cast<std::size_t>(band) + 1]; ++item) {
       const std::uint32_t t = m.band_items[item];
       const std::uint32_t* idx = &indices[3 * static_cast<std::size_t>(t)];
       const std::array<Eye, 3> tri = eye_triangle(view, colors.positions, idx);
       bool clipped = false;
       const int n = window_polygon(view, tri, poly, clipped);
       if (n == 0) continue;
-      st.stats.clipped += clipped && band == m.band_first[t] ? 1 : 0;
-      // Shading setup.
-      Shade sh;
-      const std::uint32_t v0 = idx[0];
-      sh.kind = v0 < lattice ? Kind::kTextured : v0 < colors.merged_base ? Kind::kWall : Kind::kMerged;
-      std::array<double, 3> haze{0, 0, 0};
-      if (hazy) {
-        for (int i = 0; i < 3; ++i) haze[static_cast<std::size_t>(i)] = 0.85 * (1.0 - std::exp(-tri[static_cast<std::size_t>(i)].z / look.haze_distance));
-      }
-      std::array<std::array<double, 5>, 3> attr{};  // per vertex
-      int n_attr = 0;
-      if (sh.kind == Kind::kTextured) {
-        n_attr = 3;
-        for (int i = 0; i < 3; ++i) {
-          const std::uint32_t v = idx[i];
-          const double ti = v < lattice ? static_cast<double>(v % side) : 0.0, tj = v < lattice ? static_cast<double>(v / side) : 0.0;
-          attr[static_cast<std::size_t>(i)] = {ti, tj, haze[static_cast<std::size_t>(i)], 0, 0};
-        }
-      } else if (sh.kind == Kind::kWall) {
-        n_attr = 1;
-        for (int i = 0; i < 3; ++i) attr[static_cast<std::size_t>(i)][0] = haze[static_cast<std::size_t>(i)];
-      } else {
-        n_attr = 5;
-        for (int i = 0; i < 3; ++i) {
-          const std::uint32_t v = idx[i];
-          const glm::u8vec4 c = v >= colors.merged_base ? colors.merged_colors[v - colors.merged_base] : colors.wall_color;
-          attr[static_cast<std::size_t>(i)] = {static_cast<double>(c.r), static_cast<double>(c.g), static_cast<double>(c.b),
-                                               static_cast<double>(c.a), haze[static_cast<std::size_t>(i)]};
-          sh.translucent = sh.translucent || c.a < 255;
-        }
-      }
-      for (int i = 0; i < 3; ++i) {
-        const Eye& a = tri[static_cast<std::size_t>((i + 1) % 3)];
-        const Eye& b = tri[static_cast<std::size_t>((i + 2) % 3)];
-        // e_i = (a x b) . D, D = ((x - hw) / f, (y - hh) / f, 1).
-        const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
-        const Plane e{cx / view.focal, cy / view.focal, cz - (cx * view.hw + cy * view.hh) / view.focal};
-        sh.s.a += e.a;
-        sh.s.b += e.b;
-        sh.s.c += e.c;
-        for (int k = 0; k < n_attr; ++k) {
-          const double v = attr[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
-          sh.n[static_cast<std::size_t>(k)].a += v * e.a;
-          sh.n[static_cast<std::size_t>(k)].b += v * e.b;
-          sh.n[static_cast<std::size_t>(k)].c += v * e.c;
-        }
-      }
-      if (sh.kind == Kind::kTextured) {
-        if (s.texel_rate == 0.0) {
-          sh.kx = sh.ky = aa;
-        } else {
-          // The texels a pixel spans along x and y, at the polygon's centroid.
-          glm::dvec2 c(0.0);
-          for (int i = 0; i < n; ++i) c += poly[static_cast<std::size_t>(i)];
-          c /= n;
-          const double S = sh.s.at(c.x, c.y);
-          if (S != 0.0 && std::isfinite(S)) {
-            const Plane& pu = sh.n[0];
-            const Plane& pv = sh.n[1];
-            const double U = pu.at(c.x, c.y), V = pv.at(c.x, c.y), s2 = S * S;
-            const double du_dx = (pu.a * S - U * sh.s.a) / s2, dv_dx = (pv.a * S - V * sh.s.a) / s2;
-            const double du_dy = (pu.b * S - U * sh.s.b) / s2, dv_dy = (pv.b * S - V * sh.s.b) / s2;
-            sh.kx = pow2_at_least(s.texel_rate * std::hypot(du_dx, dv_dx), aa);
-            sh.ky = pow2_at_least(s.texel_rate * std::hypot(du_dy, dv_dy), aa);
-          }
-        }
-      }
-      st.stats.translucent += sh.translucent && band == m.band_first[t] ? 1 : 0;
+      const bool first_band = band == m.band_first[t];
+      st.stats.clipped += clipped && first_band ? 1 : 0;
+      const Shade sh = setup_shade(view, colors, look, s.texel_rate, aa, idx, tri, poly, n);
+      st.stats.translucent += sh.translucent && first_band ? 1 : 0;
 
       // Tiling: the band's pyramid is in samples, its row 0 the band's first.
       st.poly.resize(static_cast<std::size_t>(n));
-      for (int i = 0; i < n; ++i) {
-        st.poly[static_cast<std::size_t>(i)] = {poly[static_cast<std::size_t>(i)].x * aa,
-                                                (poly[static_cast<std::size_t>(i)].y - row0) * aa};
-      }
+      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) st.poly[i] = {poly[i].x * aa, (poly[i].y - row0) * aa};
       st.records.clear();
       if (sh.translucent) {
         pyramid.vacant(st.poly, 0.0, st.records);
@@ -581,67 +711,44 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       }
       ++st.stats.tiled;
 
-      // The colour (0..255) and opacity at window point (x, y).
-      const auto shade_at = [&](double x, double y, double& alpha) {
-        ++st.stats.shading_points;
-        double S = sh.s.at(x, y);
-        if (S == 0.0 || !std::isfinite(S)) S = std::numeric_limits<double>::min();
-        const double inv = 1.0 / S;
-        glm::dvec3 c;
-        double h = 0;
-        alpha = 1.0;
-        switch (sh.kind) {
-          case Kind::kTextured:
-            c = texel(colors.texture, static_cast<int>(side), sh.n[0].at(x, y) * inv, sh.n[1].at(x, y) * inv);
-            h = sh.n[2].at(x, y) * inv;
-            break;
-          case Kind::kWall:
-            c = glm::dvec3(colors.wall_color.r, colors.wall_color.g, colors.wall_color.b);
-            h = sh.n[0].at(x, y) * inv;
-            break;
-          case Kind::kMerged:
-            c = glm::dvec3(sh.n[0].at(x, y), sh.n[1].at(x, y), sh.n[2].at(x, y)) * inv;
-            alpha = std::clamp(sh.n[3].at(x, y) * inv / 255.0, 0.0, 1.0);
-            h = sh.n[4].at(x, y) * inv;
-            break;
-        }
-        if (hazy) c = c + (haze_color - c) * h;
-        return c;
-      };
-
+      // The fragments: per pixel of each reported tile, its newly covered (or shown) samples.
+      const bool blocks = sh.kx > 1 || sh.ky > 1;
+      const float y_base = static_cast<float>(row0);
       for (const coverage::TileMask& rec : st.records) {
         for (int j = 0; j < per_tile; ++j) {
           for (int i = 0; i < per_tile; ++i) {
-            const std::uint64_t sub = (rec.mask >> (8 * j * aa + i * aa)) & full;
+            const int shift = 8 * j * aa + i * aa;
+            const std::uint64_t sub = (rec.mask >> shift) & full;
             if (!sub) continue;
-            const int px = rec.tx * per_tile + i, py = row0 + rec.ty * per_tile + j;
+            const int px = rec.tx * per_tile + i, py = rec.ty * per_tile + j;
             const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
             ++st.stats.fragments;
-            const int count = popcount(sub);
+            const bool whole = sub == full;
+            const int c = whole ? N : popcount(sub);
+            const glm::vec2 q = whole ? glm::vec2(0.5f * aa) : centroid(sub, c);
+            const float x = static_cast<float>(px) + q.x * inv_aa, y = y_base + static_cast<float>(py) + q.y * inv_aa;
+            float alpha = 1.0f;
             if (sh.translucent) {
-              const std::uint64_t covered = (pyramid.tile_bits(rec.tx, rec.ty) >> (8 * j * aa + i * aa)) & full;
-              const glm::dvec2 q = centroid(sub, count);
-              double alpha = 1;
-              const glm::dvec3 c = shade_at(px + q.x * inv_aa, py + q.y * inv_aa, alpha);
-              add_translucent(p, sub, covered, c, alpha);
-              continue;
-            }
-            st.stats.samples_covered += static_cast<std::uint64_t>(count);
-            m.counts[p] = static_cast<std::uint8_t>(m.counts[p] + count);
-            if (sh.kx == 1 && sh.ky == 1) {
-              const glm::dvec2 q = centroid(sub, count);
-              double alpha = 1;
-              add(p, sub, shade_at(px + q.x * inv_aa, py + q.y * inv_aa, alpha), 1.0);
-              continue;
-            }
-            const int bw = aa / sh.kx, bh = aa / sh.ky;
-            for (int by = 0; by < sh.ky; ++by) {
-              for (int bx = 0; bx < sh.kx; ++bx) {
-                const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
-                if (!part) continue;
-                const glm::dvec2 q = centroid(part, popcount(part));
-                double alpha = 1;
-                add(p, part, shade_at(px + q.x * inv_aa, py + q.y * inv_aa, alpha), 1.0);
+              ++st.stats.shading_points;
+              const Color col = shader(sh, x, y, alpha);
+              out.translucent(p, sub, c, (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full, col, alpha);
+            } else if (!blocks) {
+              ++st.stats.shading_points;
+              out.opaque(p, sub, c, shader(sh, x, y, alpha));
+            } else {
+              // Block by block: each block's samples shaded at their centroid.
+              out.counts[p] = static_cast<std::uint8_t>(out.counts[p] + c);
+              st.stats.samples_covered += static_cast<std::uint64_t>(c);
+              const int bw = aa / sh.kx, bh = aa / sh.ky;
+              for (int by = 0; by < sh.ky; ++by) {
+                for (int bx = 0; bx < sh.kx; ++bx) {
+                  const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
+                  if (!part) continue;
+                  const int pc = popcount(part);
+                  const glm::vec2 pq = centroid(part, pc);
+                  ++st.stats.shading_points;
+                  out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
+                }
               }
             }
           }
@@ -650,9 +757,11 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     }
 
     // The sky over every sample still vacant (section 4.5: "composite a screen-sized polygon of
-    // the desired background color"), then the pixels of the band.
+    // the desired background color"), then the band's pixels.
     const int tiles_x = pyramid.grid_width(0), tiles_y = pyramid.grid_height(0);
-    const glm::dvec3 bottom = look.sky_bottom, top = look.sky_top;
+    const Color bottom(static_cast<float>(look.sky_bottom.r), static_cast<float>(look.sky_bottom.g), static_cast<float>(look.sky_bottom.b));
+    const Color top(static_cast<float>(look.sky_top.r), static_cast<float>(look.sky_top.g), static_cast<float>(look.sky_top.b));
+    const float inv_h = 1.0f / static_cast<float>(H);
     for (int ty = 0; ty < tiles_y; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         const std::uint64_t open = ~pyramid.tile_bits(tx, ty);
@@ -661,29 +770,26 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
           for (int i = 0; i < per_tile; ++i) {
             const std::uint64_t sub = (open >> (8 * j * aa + i * aa)) & full;
             if (!sub) continue;
-            const int px = tx * per_tile + i, py = row0 + ty * per_tile + j;
+            const int px = tx * per_tile + i, py = ty * per_tile + j;
             const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
-            const int count = popcount(sub);
-            const glm::dvec2 q = centroid(sub, count);
-            const double y = (py + q.y * inv_aa) / H;
-            add(p, sub, bottom + (top - bottom) * y, 1.0);
-            st.stats.samples_background += static_cast<std::uint64_t>(count);
-            m.counts[p] = static_cast<std::uint8_t>(m.counts[p] + count);
+            const int c = sub == full ? N : popcount(sub);
+            const float qy = sub == full ? 0.5f * aa : centroid(sub, c).y;
+            const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;
+            out.add(p, sub, c, bottom + (top - bottom) * f, 1.0f);
+            out.counts[p] = static_cast<std::uint8_t>(out.counts[p] + c);
+            st.stats.samples_background += static_cast<std::uint64_t>(c);
           }
         }
       }
     }
     const float scale = 1.0f / static_cast<float>(N);
-    for (int y = row0; y < row0 + rows; ++y) {
+    for (int y = 0; y < rows; ++y) {
       const std::size_t src = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
-      const std::size_t dst = static_cast<std::size_t>(H - 1 - y) * static_cast<std::size_t>(W);
-      for (int x = 0; x < W; ++x) {
-        for (int k = 0; k < 3; ++k) {
-          const float v = m.acc[3 * (src + static_cast<std::size_t>(x)) + static_cast<std::size_t>(k)] * scale;
-          rgb_[3 * (dst + static_cast<std::size_t>(x)) + static_cast<std::size_t>(k)] =
-              static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));
-        }
-        counts_[dst + static_cast<std::size_t>(x)] = m.counts[src + static_cast<std::size_t>(x)];
+      const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
+      for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
+        const std::array<float, 4> v = (out.acc[src + x] * scale).lanes();
+        for (std::size_t k = 0; k < 3; ++k) rgb_[3 * (dst + x) + k] = static_cast<std::uint8_t>(std::clamp(v[k] + 0.5f, 0.0f, 255.0f));
+        counts_[dst + x] = out.counts[src + x];
       }
     }
     st.stats.cells_visited += pyramid.stats().cells_visited;
@@ -695,23 +801,23 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     });
   });
 
-  Stats out;
-  out.triangles = n_tri;
+  Stats total;
+  total.triangles = n_tri;
   for (const Impl::BandState& st : m.states) {
-    out.translucent += st.stats.translucent;
-    out.clipped += st.stats.clipped;
-    out.tiled += st.stats.tiled;
-    out.fragments += st.stats.fragments;
-    out.shading_points += st.stats.shading_points;
-    out.samples_covered += st.stats.samples_covered;
-    out.samples_background += st.stats.samples_background;
-    out.cells_visited += st.stats.cells_visited;
-    out.class_splits += st.stats.class_splits;
+    total.translucent += st.stats.translucent;
+    total.clipped += st.stats.clipped;
+    total.tiled += st.stats.tiled;
+    total.fragments += st.stats.fragments;
+    total.shading_points += st.stats.shading_points;
+    total.samples_covered += st.stats.samples_covered;
+    total.samples_background += st.stats.samples_background;
+    total.cells_visited += st.stats.cells_visited;
+    total.class_splits += st.stats.class_splits;
   }
-  out.setup_ms = setup_ms;
-  out.tile_ms = ms_since(t_tile);
-  out.total_ms = ms_since(t_start);
-  return out;
+  total.setup_ms = setup_ms;
+  total.tile_ms = ms_since(t_tile);
+  total.total_ms = ms_since(t_start);
+  return total;
 }
 
 }  // namespace terravol::tiler

@@ -147,8 +147,9 @@ TEST(TilerRenderer, SingleTrianglesCoverExactlyTheBruteForceSamples) {
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
           const int n = want[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
-          const auto expect = static_cast<int>(std::lround(255.0 * n / (aa * aa)));
-          ASSERT_EQ(at(r.rgb(), w, h, x, y, 0), expect) << "aa " << aa << " trial " << trial << " pixel " << x << ", " << y;
+          // Within 1 level of the brute force's share (the colour is interpolated in float):
+          // one sample is worth 255 / 64 = 4 levels or more.
+          ASSERT_NEAR(at(r.rgb(), w, h, x, y, 0), 255.0 * n / (aa * aa), 1.0) << "aa " << aa << " trial " << trial << " pixel " << x << ", " << y;
         }
       }
     }
