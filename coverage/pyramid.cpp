@@ -390,17 +390,11 @@ void Pyramid::propagate(int level, int cx, int cy) {
   }
 }
 
-// Marks a vacant element and everything below it wholly covered (and reports its tiles when
-// recording); in vacant() only reports them.
+// Marks a vacant element and everything below it wholly covered (cover_cell reports it).
 void Pyramid::fill(int level, int cx, int cy) {
-  if (!claim_) {
-    report_subtree(level, cx, cy);
-    return;
-  }
   if (level == 0) {
     tile(cx, cy) = kAll;
     ++stats_.cells_filled;
-    if (record_) report(cx, cy, kAll);
     return;
   }
   Cell& m = cell(level, cx, cy);
@@ -410,27 +404,17 @@ void Pyramid::fill(int level, int cx, int cy) {
   if (level == 1) {
     for (int j = 0; j < 8; ++j) std::fill_n(&tile(8 * cx, 8 * cy + j), 8, kAll);
     stats_.cells_filled += 64;
-    if (record_) report_subtree(1, cx, cy);
     return;
   }
   for (int j = 0; j < 8; ++j)
     for (int i = 0; i < 8; ++i) fill(level - 1, 8 * cx + i, 8 * cy + j);
 }
 
-// Reports every tile of a vacant element (all of its pixels: a vacant element has every child,
-// since missing children count as covered) to record_, row by row.
+// Reports every pixel of a (formerly) vacant element to record_: its tiles row by row, each row
+// one run (a vacant element has every child, since missing children count as covered).
 void Pyramid::report_subtree(int level, int cx, int cy) {
-  if (level == 0) {
-    report(cx, cy, kAll);
-    return;
-  }
-  if (level == 1) {
-    for (int j = 0; j < 8; ++j)
-      for (int i = 0; i < 8; ++i) report(8 * cx + i, 8 * cy + j, kAll);
-    return;
-  }
-  for (int j = 0; j < 8; ++j)
-    for (int i = 0; i < 8; ++i) report_subtree(level - 1, 8 * cx + i, 8 * cy + j);
+  const int side = 1 << (3 * level);  // tiles per side
+  for (int j = 0; j < side; ++j) record_->push_back({cx * side, cy * side + j, kAll, side});
 }
 
 namespace {
@@ -484,7 +468,8 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
     }
     for (std::uint64_t bits = w; bits; bits &= bits - 1) {
       const int bit = std::countr_zero(bits);
-      fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+      if (claim_) fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+      if (record_) report_subtree(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
     }
   }
   for (std::uint64_t active = ~(w | pv | m.c); active; active &= active - 1) {

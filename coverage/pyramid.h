@@ -53,10 +53,13 @@ inline constexpr double kMaxCoordinate = 16777216.0;  // 2^24 px: |x| and |y| of
 inline constexpr double kMaxMargin = 256.0;    // px: margin and dilation are in [0, kMaxMargin]
 inline constexpr int kMaxVertices = 64;        // vertices of one polygon
 
-// Pixels of one finest tile: bit (y % 8) * 8 + x % 8 of tile (tx, ty) = (x / 8, y / 8).
+// Pixels of `run` finest tiles in a row, (tx, ty) to (tx + run - 1, ty), each with the same
+// mask: bit (y % 8) * 8 + x % 8 of tile (x / 8, y / 8). Runs longer than 1 have every pixel
+// (a whole cell the polygon covers, reported row by row).
 struct TileMask {
   int tx = 0, ty = 0;
   std::uint64_t mask = 0;
+  int run = 1;
 };
 
 // Not thread-safe (hidden() counts into the stats too): one pyramid per thread.
@@ -93,10 +96,12 @@ class Pyramid {
   void cover(std::span<const glm::dvec2> polygon, double margin_px);
 
   // cover(), and every pixel it newly covers appended to `claimed` (not cleared first), tile by
-  // tile: for the renderer that shades what each polygon claims (Greene, section 3.1: the W
-  // masks, down to the finest level). A tile may appear more than once with disjoint masks;
-  // every mask is non-zero; no pixel is reported twice between two clear()s, and the union of
-  // the masks is exactly the set of pixels the call covered. Same contract and throws as cover().
+  // tile or in runs of whole tiles: for the renderer that shades what each polygon claims
+  // (Greene, section 3.1: the W masks, down to the finest level; a triage W bit, a whole cell,
+  // comes as one run per row of its tiles). A tile may appear more than once with disjoint
+  // masks; every mask is non-zero; no pixel is reported twice between two clear()s, and the
+  // union of the masks is exactly the set of pixels the call covered. Same contract and throws
+  // as cover().
   void cover(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& claimed);
 
   // The pixels cover(polygon, margin_px) would claim now (those of the polygon still vacant),
@@ -176,7 +181,7 @@ class Pyramid {
   void cover_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
   void cover_polygon(std::span<const glm::dvec2> polygon, double margin_px);
   void record(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& to, bool claim);
-  void report(int tx, int ty, std::uint64_t mask) { record_->push_back({tx, ty, mask}); }
+  void report(int tx, int ty, std::uint64_t mask) { record_->push_back({tx, ty, mask, 1}); }
   void report_subtree(int level, int cx, int cy);
   bool hidden_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
   bool hidden_tile(int tx, int ty, const Edges& edges, const std::uint8_t* act, int n, int j0, int j1);

@@ -48,6 +48,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -66,6 +67,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// CPU time of the calling thread, milliseconds.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
 
 constexpr double kGuard = 65536.0;  // pixels beyond the viewport that a clipped polygon may reach
 constexpr int kMaxClipped = 3 + 6;  // a triangle clipped by six planes
@@ -315,6 +323,16 @@ struct Class {
   std::int32_t next;
 };
 
+// What a pixel accumulates (one 32-byte record, so that a fragment touches one cache line): the
+// colour summed over its samples (0..255 each), the transmittance of its open samples when it is
+// uniform, else the head of its transmittance classes (-1: uniform), the samples shaded.
+struct alignas(32) Pixel {
+  Color acc;
+  float t = 1.0f;
+  std::int32_t head = -1;
+  std::uint32_t count = 0;
+};
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -324,6 +342,7 @@ struct Renderer::Impl {
     std::vector<std::unique_ptr<coverage::Pyramid>> pyramids;
     std::vector<coverage::TileMask> records;
     std::vector<Class> classes;
+    std::vector<Pixel> pixels;  // the band's, rows from its first (bottom) one
     std::vector<glm::dvec2> poly;
     Stats stats;
     coverage::Pyramid& pyramid(int w, int h) {
@@ -340,12 +359,6 @@ struct Renderer::Impl {
   // Per triangle of the frame: the bands its projection reaches (first > last: none).
   std::vector<std::int32_t> band_first, band_last;
   std::vector<std::uint32_t> band_start, band_items;  // triangles of band b: items [start[b], start[b+1])
-  // Per pixel, rows from the bottom: the accumulated colour (sum over samples, 0..255), the
-  // uniform transmittance, the head of the transmittance classes (-1: uniform), shaded samples.
-  std::vector<Color> acc;
-  std::vector<float> uniform_t;
-  std::vector<std::int32_t> head;
-  std::vector<std::uint8_t> counts;
 };
 
 namespace {
@@ -353,10 +366,7 @@ namespace {
 // A band's pixels being accumulated: the colour sums, transmittance and sample counts of the
 // pixels of one band (rows from the bottom), and its transmittance classes.
 struct Accumulator {
-  Color* acc;
-  float* uniform_t;
-  std::int32_t* head;
-  std::uint8_t* counts;
+  Pixel* px;
   std::vector<Class>& classes;
   Stats& stats;
   std::uint64_t full;  // a pixel's samples
@@ -365,9 +375,10 @@ struct Accumulator {
   // its transmittance.
   void add(std::size_t p, std::uint64_t mask, int count, Color c, float weight) {
     float w = 0;
-    const std::int32_t h0 = head[p];
+    Pixel& q = px[p];
+    const std::int32_t h0 = q.head;
     if (h0 < 0) {
-      w = static_cast<float>(count) * uniform_t[p];
+      w = static_cast<float>(count) * q.t;
     } else {
       for (std::int32_t k = h0; k >= 0; k = classes[static_cast<std::size_t>(k)].next) {
         const Class& cl = classes[static_cast<std::size_t>(k)];
@@ -375,12 +386,12 @@ struct Accumulator {
         if (i) w += static_cast<float>(popcount(i)) * cl.t;
       }
     }
-    acc[p] += c * (w * weight);
+    q.acc += c * (w * weight);
   }
 
   // An opaque fragment's newly covered samples: shaded once or block by block.
   void opaque(std::size_t p, std::uint64_t mask, int count, Color c) {
-    counts[p] = static_cast<std::uint8_t>(counts[p] + count);
+    px[p].count += static_cast<std::uint32_t>(count);
     stats.samples_covered += static_cast<std::uint64_t>(count);
     add(p, mask, count, c, 1.0f);
   }
@@ -390,14 +401,14 @@ struct Accumulator {
   void translucent(std::size_t p, std::uint64_t mask, int count, std::uint64_t covered, Color c, float alpha) {
     add(p, mask, count, c, alpha);
     const float keep = 1.0f - alpha;
-    std::int32_t& h0 = head[p];
+    std::int32_t& h0 = px[p].head;
     if (h0 < 0) {
       const std::uint64_t rest = full & ~mask & ~covered;
       if (!rest) {
-        uniform_t[p] *= keep;
+        px[p].t *= keep;
         return;
       }
-      const float t = uniform_t[p];
+      const float t = px[p].t;
       classes.push_back({rest, t, -1});
       classes.push_back({mask, t * keep, static_cast<std::int32_t>(classes.size()) - 1});
       h0 = static_cast<std::int32_t>(classes.size()) - 1;
@@ -448,7 +459,7 @@ struct Accumulator {
     }
     // (mask is open and not empty, so some class is left.)
     if (classes[static_cast<std::size_t>(h0)].next < 0) {
-      uniform_t[p] = classes[static_cast<std::size_t>(h0)].t;
+      px[p].t = classes[static_cast<std::size_t>(h0)].t;
       h0 = -1;
     }
   }
@@ -474,10 +485,6 @@ Renderer::Renderer(const Settings& settings) : settings_(settings), impl_(std::m
   const std::size_t pixels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
   rgb_.assign(pixels * 3, 0);
   counts_.assign(pixels, 0);
-  impl_->acc.assign(pixels, Color());
-  impl_->uniform_t.assign(pixels, 1.0f);
-  impl_->head.assign(pixels, -1);
-  impl_->counts.assign(pixels, 0);
 }
 
 Renderer::~Renderer() = default;
@@ -674,17 +681,14 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   // One band: its triangles tiled into its own pyramid, front to back, then the sky.
   const auto draw_band = [&](int band) {
     Impl::BandState& st = m.states.local();
+    const double cpu0 = thread_cpu_ms();
     const int row0 = band * R, rows = std::min(R, H - row0);
     coverage::Pyramid& pyramid = st.pyramid(W * aa, rows * aa);
     st.classes.clear();
-    const std::size_t first = static_cast<std::size_t>(row0) * static_cast<std::size_t>(W);
     const std::size_t count = static_cast<std::size_t>(rows) * static_cast<std::size_t>(W);
-    std::fill_n(m.acc.begin() + static_cast<std::ptrdiff_t>(first), count, Color());
-    std::fill_n(m.uniform_t.begin() + static_cast<std::ptrdiff_t>(first), count, 1.0f);
-    std::fill_n(m.head.begin() + static_cast<std::ptrdiff_t>(first), count, -1);
-    std::fill_n(m.counts.begin() + static_cast<std::ptrdiff_t>(first), count, std::uint8_t{0});
+    st.pixels.assign(count, Pixel());
     // Pixel p of the band: (x, y) with y counted from the band's first row.
-    Accumulator out{m.acc.data() + first, m.uniform_t.data() + first, m.head.data() + first, m.counts.data() + first,
+    Accumulator out{st.pixels.data(),
                     st.classes, st.stats, full};
 
     std::array<glm::dvec2, kMaxClipped> poly;
@@ -714,43 +718,56 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       // The fragments: per pixel of each reported tile, its newly covered (or shown) samples.
       const bool blocks = sh.kx > 1 || sh.ky > 1;
       const float y_base = static_cast<float>(row0);
+      // Pixel (px, py) of the band, its samples sub (count c, centroid q in samples), the pixel's
+      // covered samples (translucent triangles only).
+      const auto fragment = [&](int px, int py, std::uint64_t sub, int c, glm::vec2 q, std::uint64_t covered) {
+        const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
+        ++st.stats.fragments;
+        const float x = static_cast<float>(px) + q.x * inv_aa, y = y_base + static_cast<float>(py) + q.y * inv_aa;
+        float alpha = 1.0f;
+        if (sh.translucent) {
+          ++st.stats.shading_points;
+          const Color col = shader(sh, x, y, alpha);
+          out.translucent(p, sub, c, covered, col, alpha);
+        } else if (!blocks) {
+          ++st.stats.shading_points;
+          out.opaque(p, sub, c, shader(sh, x, y, alpha));
+        } else {
+          // Block by block: each block's samples shaded at their centroid.
+          out.px[p].count += static_cast<std::uint32_t>(c);
+          st.stats.samples_covered += static_cast<std::uint64_t>(c);
+          const int bw = aa / sh.kx, bh = aa / sh.ky;
+          for (int by = 0; by < sh.ky; ++by) {
+            for (int bx = 0; bx < sh.kx; ++bx) {
+              const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
+              if (!part) continue;
+              const int pc = popcount(part);
+              const glm::vec2 pq = centroid(part, pc);
+              ++st.stats.shading_points;
+              out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
+            }
+          }
+        }
+      };
+      const glm::vec2 centre(0.5f * static_cast<float>(aa));
       for (const coverage::TileMask& rec : st.records) {
+        if (rec.run > 1) {
+          // Whole tiles (a cell the triangle covers): every sample of every pixel, vacant before.
+          for (int j = 0; j < per_tile; ++j) {
+            const int py = rec.ty * per_tile + j;
+            for (int px = rec.tx * per_tile; px < (rec.tx + rec.run) * per_tile; ++px) fragment(px, py, full, N, centre, 0);
+          }
+          continue;
+        }
         for (int j = 0; j < per_tile; ++j) {
           for (int i = 0; i < per_tile; ++i) {
             const int shift = 8 * j * aa + i * aa;
             const std::uint64_t sub = (rec.mask >> shift) & full;
             if (!sub) continue;
-            const int px = rec.tx * per_tile + i, py = rec.ty * per_tile + j;
-            const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
-            ++st.stats.fragments;
             const bool whole = sub == full;
             const int c = whole ? N : popcount(sub);
-            const glm::vec2 q = whole ? glm::vec2(0.5f * aa) : centroid(sub, c);
-            const float x = static_cast<float>(px) + q.x * inv_aa, y = y_base + static_cast<float>(py) + q.y * inv_aa;
-            float alpha = 1.0f;
-            if (sh.translucent) {
-              ++st.stats.shading_points;
-              const Color col = shader(sh, x, y, alpha);
-              out.translucent(p, sub, c, (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full, col, alpha);
-            } else if (!blocks) {
-              ++st.stats.shading_points;
-              out.opaque(p, sub, c, shader(sh, x, y, alpha));
-            } else {
-              // Block by block: each block's samples shaded at their centroid.
-              out.counts[p] = static_cast<std::uint8_t>(out.counts[p] + c);
-              st.stats.samples_covered += static_cast<std::uint64_t>(c);
-              const int bw = aa / sh.kx, bh = aa / sh.ky;
-              for (int by = 0; by < sh.ky; ++by) {
-                for (int bx = 0; bx < sh.kx; ++bx) {
-                  const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
-                  if (!part) continue;
-                  const int pc = popcount(part);
-                  const glm::vec2 pq = centroid(part, pc);
-                  ++st.stats.shading_points;
-                  out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
-                }
-              }
-            }
+            const std::uint64_t covered = sh.translucent ? (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full : 0;
+            fragment(rec.tx * per_tile + i, rec.ty * per_tile + j, sub, c, whole ? centre : centroid(sub, c), covered);
           }
         }
       }
@@ -776,7 +793,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             const float qy = sub == full ? 0.5f * aa : centroid(sub, c).y;
             const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;
             out.add(p, sub, c, bottom + (top - bottom) * f, 1.0f);
-            out.counts[p] = static_cast<std::uint8_t>(out.counts[p] + c);
+            out.px[p].count += static_cast<std::uint32_t>(c);
             st.stats.samples_background += static_cast<std::uint64_t>(c);
           }
         }
@@ -787,12 +804,13 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       const std::size_t src = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
       const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
       for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
-        const std::array<float, 4> v = (out.acc[src + x] * scale).lanes();
+        const std::array<float, 4> v = (out.px[src + x].acc * scale).lanes();
         for (std::size_t k = 0; k < 3; ++k) rgb_[3 * (dst + x) + k] = static_cast<std::uint8_t>(std::clamp(v[k] + 0.5f, 0.0f, 255.0f));
-        counts_[dst + x] = out.counts[src + x];
+        counts_[dst + x] = static_cast<std::uint8_t>(std::min<std::uint32_t>(out.px[src + x].count, 255));
       }
     }
     st.stats.cells_visited += pyramid.stats().cells_visited;
+    st.stats.tile_cpu_ms += thread_cpu_ms() - cpu0;
   };
 
   run([&] {
@@ -813,6 +831,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     total.samples_background += st.stats.samples_background;
     total.cells_visited += st.stats.cells_visited;
     total.class_splits += st.stats.class_splits;
+    total.tile_cpu_ms += st.stats.tile_cpu_ms;
   }
   total.setup_ms = setup_ms;
   total.tile_ms = ms_since(t_tile);

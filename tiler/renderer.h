@@ -82,6 +82,7 @@ struct Stats {
   std::uint64_t cells_visited = 0;      // pyramid cells and tiles composited (Greene, section 9)
   std::size_t class_splits = 0;         // translucent transmittance classes split (partly covered pixels)
   double setup_ms = 0, tile_ms = 0, total_ms = 0;  // wall: projection and binning; bands; all
+  double tile_cpu_ms = 0;               // CPU time of the bands, over every thread
 };
 
 class Renderer {

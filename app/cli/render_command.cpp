@@ -160,7 +160,8 @@ void run_render(const RenderOptions& o) {
                     {"cells_visited_per_pixel", static_cast<double>(t.cells_visited) / pixels},
                     {"class_splits", t.class_splits},
                     {"setup_ms", t.setup_ms},
-                    {"tile_ms", t.tile_ms}};
+                    {"tile_ms", t.tile_ms},
+                    {"tile_cpu_ms", t.tile_cpu_ms}};
     }
     j["lod_metric"] = scene::metric_name(traversal.metric);
     j["threshold_px"] = traversal.threshold_px;

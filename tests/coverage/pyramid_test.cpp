@@ -394,26 +394,29 @@ TEST(Cover, TriangulatedGridWithoutMarginClaimsEveryCentreExactlyOnce) {
   EXPECT_EQ(all.check_invariants(), "");
 }
 
-// The pixels of `masks` as a bitmap; fails (returns false) when a pixel is reported twice, a
-// mask is empty, or a pixel lies outside the viewport.
+// The pixels of `masks` (runs of tiles) as a bitmap; fails (returns false) when a pixel is
+// reported twice, a mask is empty, a run longer than one tile is not of whole tiles, or a pixel
+// lies outside the viewport.
 bool reported_bitmap(const std::vector<TileMask>& masks, Bitmap& out, std::string& why) {
   for (const TileMask& t : masks) {
-    if (t.mask == 0) {
-      why = "an empty mask for tile (" + std::to_string(t.tx) + ", " + std::to_string(t.ty) + ")";
+    if (t.mask == 0 || t.run < 1 || (t.run > 1 && t.mask != ~std::uint64_t{0})) {
+      why = "an empty mask or a bad run at tile (" + std::to_string(t.tx) + ", " + std::to_string(t.ty) + ")";
       return false;
     }
-    for (int bit = 0; bit < 64; ++bit) {
-      if (!((t.mask >> bit) & 1)) continue;
-      const int x = 8 * t.tx + (bit & 7), y = 8 * t.ty + (bit >> 3);
-      if (x < 0 || y < 0 || x >= out.w || y >= out.h) {
-        why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the viewport";
-        return false;
+    for (int k = 0; k < t.run; ++k) {
+      for (int bit = 0; bit < 64; ++bit) {
+        if (!((t.mask >> bit) & 1)) continue;
+        const int x = 8 * (t.tx + k) + (bit & 7), y = 8 * t.ty + (bit >> 3);
+        if (x < 0 || y < 0 || x >= out.w || y >= out.h) {
+          why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the viewport";
+          return false;
+        }
+        if (out.at(x, y)) {
+          why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") reported twice";
+          return false;
+        }
+        out.at(x, y) = 1;
       }
-      if (out.at(x, y)) {
-        why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") reported twice";
-        return false;
-      }
-      out.at(x, y) = 1;
     }
   }
   return true;
