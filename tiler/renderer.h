@@ -41,7 +41,7 @@ struct Settings {
   // own (exact supersampling of the texture). Untextured triangles (walls, merged polygons)
   // have colours linear across them and are shaded at each fragment's centroid.
   double texel_rate = 1.0;
-  int band_rows = 32;  // output pixel rows per band; bands are tiled in parallel, each with its own pyramid
+  int band_rows = 64;  // output pixel rows per band; bands are tiled in parallel, each with its own pyramid
   int threads = 0;     // worker threads, 0: TBB's default
 };
 

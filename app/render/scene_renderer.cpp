@@ -106,6 +106,7 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
                                   options_.shading);
   if (tiled_) {
     if (options_.legend) tiled_->set_legend(volumes_.legend());
+    tiled_->set_labels(volumes_.marker_labels());
     return;
   }
   const mrbsp::TerrainTree& tree = scene_->tree();
@@ -367,6 +368,7 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
   if (tiled_) {
     if (options_.legend) tiled_->set_legend(volumes_.legend());
+    tiled_->set_labels(volumes_.marker_labels());
     return volumes_.figures();
   }
   sync_vertices(*renderer_);

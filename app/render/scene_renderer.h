@@ -62,7 +62,7 @@ struct SceneOptions {
   // What draws the frames: VTK (TerrainRenderer), or the coverage-mask tiler (TiledRenderer:
   // no VTK window, no X display; the traversal runs front to back, tiled_traversal). The
   // tiler draws filled triangles in the tree's order only: RenderSettings' order must be kBsp,
-  // without wireframe or LOD colours. The marker labels are not drawn by the tiler.
+  // without wireframe or LOD colours.
   scene::Engine engine = scene::Engine::kVtk;
   tiler::Settings tiler;  // kTiler: aa, texel rate, bands, threads (the size is the RenderSettings')
 };

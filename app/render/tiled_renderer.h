@@ -2,12 +2,17 @@
 // `terravol render --renderer tiler`, `fly --renderer tiler` and the antialiasing benchmark.
 // It takes the tree's front-to-back frame and the same colours as the VTK path (the lattice
 // texture, walls, merged polygons' RGBA, per-vertex haze, the sky gradient), and lays the
-// legend card over the image as the VTK path does. Needs no X display and no OpenGL.
+// legend card and the markers' labels over the image as the VTK path does (the labels' glyphs
+// are FreeType's in both, placed alike, but not pixel for pixel VTK's billboards). Needs no X
+// display and no OpenGL.
 #pragma once
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "app/render/legend_image.h"
 #include "app/scene/terrain_colors.h"
@@ -44,6 +49,10 @@ class TiledRenderer {
   // The legend card over the image (top right, 10 px in, at most the image's height less
   // 20 px), as TerrainRenderer draws it; an empty legend: none.
   void set_legend(const scene::Legend& legend);
+  // The markers' names over the image (after the legend): white 18 px bold text with a shadow,
+  // centred above each anchor's projection, the bottom of the text on it; anchors behind the
+  // near plane are not drawn. Replaces the last labels.
+  void set_labels(const std::vector<scene::MarkerLabel>& labels);
 
   // The last image: width * height * 3 bytes, RGB, top row first.
   const std::vector<std::uint8_t>& rgb() const { return rgb_; }
@@ -55,6 +64,7 @@ class TiledRenderer {
   tiler::Stats stats_;
   std::vector<std::uint8_t> rgb_;
   std::optional<RgbaImage> legend_;
+  std::vector<std::pair<glm::dvec3, RgbaImage>> labels_;  // anchor (scene frame), text
 };
 
 }  // namespace terravol::app::render
