@@ -235,7 +235,7 @@ void add_render_command(CLI::App& app) {
   struct Raw {
     RenderOptions o;
     std::string camera, background;
-    std::string renderer = "vtk", aa = "8";
+    RendererArgs renderer;
     SceneArgs scene;
   };
   auto raw = std::make_shared<Raw>();
@@ -256,24 +256,18 @@ void add_render_command(CLI::App& app) {
   cmd->add_flag("--force", o.force, "Replace existing output files");
   cmd->add_option("--stats", o.stats, "Write figures of the render (JSON)");
   cmd->add_option("--export-vtp", o.export_vtp, "Write the triangles drawn, in draw order (VTK XML PolyData)");
-  cmd->add_option("--renderer", raw->renderer,
-                                   "vtk (OpenGL through VTK, needs an X display) or tiler (software: the tree's "
-                                   "front-to-back order tiled into a coverage pyramid, antialiased by --aa)")
-      ->capture_default_str();
-  auto* aa = cmd->add_option("--aa", raw->aa, "With --renderer tiler: samples per pixel per axis, 1, 2, 4 or 8")
-                 ->capture_default_str();
+  add_renderer_options(*cmd, raw->renderer);
   cmd->callback([=] {
     RenderOptions& opt = raw->o;
-    opt.engine = scene::parse_engine(raw->renderer);
-    opt.aa = scene::parse_aa(raw->aa);
+    const RendererChoice drawn = resolve_renderer(raw->renderer);
+    opt.engine = drawn.engine;
+    opt.aa = drawn.aa;
     if (opt.engine == scene::Engine::kTiler) {
       if (opt.wireframe || opt.lod_colors) {
         throw std::invalid_argument(std::string("--renderer tiler: draws filled triangles only (no ") +
                                     (opt.wireframe ? "--wireframe" : "--lod-colors") + ")");
       }
       if (!opt.export_vtp.empty()) throw std::invalid_argument("--export-vtp: needs --renderer vtk (the VTK polydata it writes)");
-    } else if (aa->count() > 0) {
-      throw std::invalid_argument("--aa: needs --renderer tiler (VTK's antialiasing is fly's --samples)");
     }
     // The scene file first; whatever the command line gave wins.
     const scene::SceneSpec file = read_scene_args(raw->scene, opt.dems);
@@ -290,11 +284,7 @@ void add_render_command(CLI::App& app) {
       throw std::invalid_argument(std::string("--renderer tiler: draws in the tree's own order (--order bsp), not --order ") +
                                   scene::order_name(opt.style.order));
     }
-    if (opt.engine == scene::Engine::kTiler && (opt.style.width * opt.aa > 16384 || opt.style.height * opt.aa > 16384)) {
-      throw std::invalid_argument("--size " + std::to_string(opt.style.width) + "x" + std::to_string(opt.style.height) +
-                                  " at --aa " + std::to_string(opt.aa) + ": at most 16384 samples per side (" +
-                                  std::to_string(16384 / opt.aa) + " pixels)");
-    }
+    check_tiler_size(drawn, opt.style.width, opt.style.height);
     run_render(opt);
   });
 }

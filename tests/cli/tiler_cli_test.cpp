@@ -147,6 +147,16 @@ TEST(TilerCli, FlyWritesAntialiasedFramesWithoutAnXDisplay) {
   const nlohmann::json manifest = nlohmann::json::parse(in);
   EXPECT_EQ(manifest["renderer"], "tiler");
   EXPECT_EQ(manifest["aa"], 2);
+  // Resuming with other samples, or with VTK, would mix frames of two renderings.
+  const std::string again = "fly " + path.string() + " -o " + frames.string() + "/ --fps 2 --size 160x90 --resume";
+  auto other = run_terravol_under("env -u DISPLAY", again + " --renderer tiler --aa 4");
+  EXPECT_EQ(other.status, 1);
+  EXPECT_NE(other.err.find("made with another aa (2, now 4)"), std::string::npos) << other.err;
+  if (std::getenv("DISPLAY") != nullptr) {  // VTK needs a display before it reads the folder
+    other = run_terravol(again);
+    EXPECT_EQ(other.status, 1);
+    EXPECT_NE(other.err.find("made with another"), std::string::npos) << other.err;
+  }
 }
 
 // Bad values: one line naming what is wrong, a non-zero exit, and no image.

@@ -422,6 +422,12 @@ bool reported_bitmap(const std::vector<TileMask>& masks, Bitmap& out, std::strin
   return true;
 }
 
+// The pixels of `all` not in `before`.
+Bitmap less(Bitmap all, const Bitmap& before) {
+  for (std::size_t i = 0; i < all.bits.size(); ++i) all.bits[i] = all.bits[i] && !before.bits[i];
+  return all;
+}
+
 Bitmap covered_bitmap(const Pyramid& p) {
   Bitmap b(p.width(), p.height());
   for (int y = 0; y < p.height(); ++y)
@@ -448,8 +454,7 @@ TEST(CoverReporting, ReportsExactlyThePixelsEachCoverNewlyClaims) {
       Bitmap got(w, h);
       std::string why;
       ASSERT_TRUE(reported_bitmap(claimed, got, why)) << w << "x" << h << " step " << step << ": " << why;
-      Bitmap want = claimed_ref(poly, margin, w, h);
-      for (std::size_t i = 0; i < want.bits.size(); ++i) want.bits[i] = want.bits[i] && !before.bits[i];
+      const Bitmap want = less(claimed_ref(poly, margin, w, h), before);
       ASSERT_EQ(got.bits, want.bits) << w << "x" << h << " step " << step;
       ASSERT_EQ(differences(p, covered_bitmap(plain)), "") << step;
       ASSERT_EQ(p.check_invariants(), "") << step;
@@ -476,8 +481,7 @@ TEST(CoverReporting, VacantReportsWhatCoverWouldClaimAndChangesNothing) {
       ASSERT_TRUE(reported_bitmap(shown, got, why)) << step << ": " << why;
       ASSERT_EQ(differences(p, before), "") << "vacant() changed the pyramid at step " << step;
       ASSERT_EQ(p.check_invariants(), "") << step;
-      Bitmap want = claimed_ref(poly, margin, w, h);
-      for (std::size_t i = 0; i < want.bits.size(); ++i) want.bits[i] = want.bits[i] && !before.bits[i];
+      const Bitmap want = less(claimed_ref(poly, margin, w, h), before);
       ASSERT_EQ(got.bits, want.bits) << w << "x" << h << " step " << step;
       // Then cover it (most of the time), so that later queries meet partial coverage.
       if (step % 4 != 3) {
