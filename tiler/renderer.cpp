@@ -21,7 +21,7 @@
 //    accumulation buffer is in floats, one sum per pixel, divided by aa^2 at the end.
 //  - Section 5.2 (hierarchical object-space culling, test-only tiling of node boxes) is the
 //    traversal's: mrbsp's occlusion pass, which the caller runs on a camera at sample
-//    resolution (app/render/tiled_view.h) so that it culls only nodes whose every sample is
+//    resolution (app/render/tiled_renderer.h) so that it culls only nodes whose every sample is
 //    covered; this renderer sees the triangles the traversal kept.
 // Where this departs from the paper:
 //  - Translucent triangles (isosurfaces, slices) are not tiled into the pyramid: the samples of
