@@ -8,7 +8,8 @@
 //    pixel (figure 2: "a four-level pyramid of 8x8 masks corresponds to a 512x512 image with
 //    8x8 oversampling"); with aa = 4, 2, 1 a tile holds 2x2, 4x4 or 8x8 pixels.
 //  - Section 3.1, "evaluate shading and update accumulation buffer": the W masks (newly covered
-//    samples) come back from the pyramid tile by tile (Pyramid::cover with a report), and the
+//    samples) come back from the pyramid tile by tile, whole cells as runs of tiles
+//    (Pyramid::cover with a report), and the
 //    samples are shaded and box-filtered into their pixel's accumulation, A-buffer style
 //    (section 2.2: "a single shading value is computed, weighted by the bit count of its
 //    mask"): one colour per fragment, evaluated at the centroid of the fragment's samples, so

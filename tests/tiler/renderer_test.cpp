@@ -24,6 +24,17 @@ namespace {
 using coverage::test::Bitmap;
 using coverage::test::claimed_ref;
 
+// Settings of a w x h renderer at aa (bands of band_rows, the texture shaded at texel_rate).
+Settings sized(int w, int h, int aa = 8, int band_rows = 64, double texel_rate = 1.0) {
+  Settings s;
+  s.width = w;
+  s.height = h;
+  s.aa = aa;
+  s.band_rows = band_rows;
+  s.texel_rate = texel_rate;
+  return s;
+}
+
 // A camera at the origin looking along +y, z up.
 mrbsp::Camera front_camera(int w, int h, double fov = 50.0, double near_plane = 0.5) {
   mrbsp::Camera c;
@@ -104,10 +115,7 @@ TEST(TilerRenderer, RejectsBadSettings) {
 }
 
 TEST(TilerRenderer, RejectsIndicesBeyondThePositionsAndAMismatchedCamera) {
-  Settings s;
-  s.width = 40;
-  s.height = 30;
-  Renderer r(s);
+  Renderer r(sized(40, 30));
   Scene sc;
   sc.triangle({-1, 5, -1}, {1, 5, -1}, {0, 5, 1}, {255, 255, 255, 255});
   std::vector<std::uint32_t> bad{0, 1, 3};
@@ -125,12 +133,7 @@ TEST(TilerRenderer, SingleTrianglesCoverExactlyTheBruteForceSamples) {
   for (int aa : {1, 2, 4, 8}) {
     for (int trial = 0; trial < 12; ++trial) {
       const int w = 37 + trial, h = 29;
-      Settings s;
-      s.width = w;
-      s.height = h;
-      s.aa = aa;
-      s.band_rows = 1 + trial % 7;
-      Renderer r(s);
+      Renderer r(sized(w, h, aa, 1 + trial % 7));
       const mrbsp::Camera cam = front_camera(w, h);
       std::vector<glm::dvec3> tri;
       for (int i = 0; i < 3; ++i) {
@@ -223,12 +226,7 @@ TEST(TilerRenderer, OpaqueTraversalsShadeEverySampleExactlyOnce) {
   }
   t.tree->merge(verts, cols, tris);
   for (int aa : {8, 4, 1}) {
-    Settings s;
-    s.width = 160;
-    s.height = 90;
-    s.aa = aa;
-    s.band_rows = 7;
-    s.texel_rate = aa == 4 ? 0.0 : 1.0;
+    const Settings s = sized(160, 90, aa, 7, aa == 4 ? 0.0 : 1.0);
     Renderer r(s);
     for (int view = 0; view < 6; ++view) {
       const mrbsp::Camera cam = random_camera(rng, s.width, s.height, 3200.0);
@@ -252,10 +250,7 @@ TEST(TilerRenderer, OpaqueTraversalsShadeEverySampleExactlyOnce) {
 // Translucent layers in front of an opaque one, given nearest first, composite as the "under"
 // operator says: C = sum_k c_k a_k prod_{j<k} (1 - a_j) + (prod (1 - a_k)) c_opaque.
 TEST(TilerRenderer, TranslucentLayersCompositeUnderInTheGivenOrder) {
-  Settings s;
-  s.width = 24;
-  s.height = 16;
-  Renderer r(s);
+  Renderer r(sized(24, 16));
   Scene sc;
   const auto quad = [&](double d, glm::u8vec4 c) {
     sc.triangle({-50, d, -50}, {50, d, -50}, {50, d, 50}, c);
@@ -290,12 +285,7 @@ TEST(TilerRenderer, TranslucentEdgesCompositeSampleBySample) {
   for (int aa : {8, 2}) {
     for (int trial = 0; trial < 6; ++trial) {
       const int w = 31, h = 23;
-      Settings s;
-      s.width = w;
-      s.height = h;
-      s.aa = aa;
-      s.band_rows = 5;
-      Renderer r(s);
+      Renderer r(sized(w, h, aa, 5));
       const mrbsp::Camera cam = front_camera(w, h);
       Scene sc;
       std::vector<std::vector<glm::dvec3>> tris;
@@ -351,11 +341,7 @@ TEST(TilerRenderer, TranslucentEdgesCompositeSampleBySample) {
 // The sky is VTK's linear gradient: at a pixel, bottom + (top - bottom) times the height of its
 // centre over the image's.
 TEST(TilerRenderer, EmptyViewIsTheLinearSkyGradient) {
-  Settings s;
-  s.width = 8;
-  s.height = 50;
-  s.aa = 4;
-  Renderer r(s);
+  Renderer r(sized(8, 50, 4));
   Look look;
   look.sky_bottom = glm::dvec3(200, 10, 0);
   look.sky_top = glm::dvec3(0, 110, 250);
@@ -386,12 +372,7 @@ TEST(TilerRenderer, TextureIsBilinearBetweenTexelCentresAndHazeMixesIn) {
   sc.texture = rgba;
   sc.merged_base = 4;
   for (double rate : {1.0, 0.0}) {
-    Settings s;
-    s.width = 64;
-    s.height = 64;
-    s.aa = 4;
-    s.texel_rate = rate;
-    Renderer r(s);
+    Renderer r(sized(64, 64, 4, 64, rate));
     const mrbsp::Camera cam = front_camera(64, 64, 90.0);  // the view spans x, z in [-10, 10] at y = 10
     Look look = black_sky();
     r.render(sc, look, cam, 100.0, idx);
@@ -421,11 +402,7 @@ TEST(TilerRenderer, TextureIsBilinearBetweenTexelCentresAndHazeMixesIn) {
 // the plane and nothing else, as a ray cast finds (up to samples next to its edges).
 TEST(TilerRenderer, TriangleThroughTheNearPlaneIsClippedThere) {
   const int w = 64, h = 48, aa = 4;
-  Settings s;
-  s.width = w;
-  s.height = h;
-  s.aa = aa;
-  Renderer r(s);
+  Renderer r(sized(w, h, aa));
   const mrbsp::Camera cam = front_camera(w, h, 60.0, 2.0);
   Scene sc;
   sc.triangle({-3, -5, -1}, {4, 20, -2}, {-2, 15, 3}, {255, 255, 255, 255});
