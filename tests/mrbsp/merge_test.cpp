@@ -195,7 +195,7 @@ TEST(Merge, ASlideByWholeCellsKeepsWhatStaysAndDrawsWhatAFreshMergeDraws) {
   const Soup soup = soup_over_sliding_terrain(rng, 60);
   TerrainTree slid(terrain.window_at(0, 0).view(), 3);  // level 0: 4 x 4 cells of 4 x 4 samples
   slid.merge(soup.v, soup.c, soup.t);
-  const int walk[][2] = {{8, 4}, {4, 16}, {16, 16}, {8, 8}, {12, 4}};
+  const int walk[][2] = {{8, 4}, {4, 16}, {16, 16}, {8, 8}, {12, 4}, {12, 12}, {12, 12}};
   for (const auto& at : walk) {
     const TestWindow w = terrain.window_at(at[0], at[1]);
     slid.slide(w.view());
