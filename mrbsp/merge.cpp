@@ -154,7 +154,7 @@ class Distributor {
 
   // Every triangle anew.
   void run() {
-    s_.pieces.clear();
+    gathered_.clear();
     s_.refs.clear();
     s_.vertices.resize(s_.input_vertices);
     s_.colors.resize(s_.input_vertices);
@@ -169,7 +169,10 @@ class Distributor {
   // outside places that lie where places lay before (`kept_places`, their keys); the triangles reaching beyond
   // the rectangle are sent through the tree again, and what comes to a region inside it, or to
   // a kept band, is left out (its pieces are there already).
-  void run_outside(const TerrainTree::Impl::Region& kept, const std::unordered_set<SlotKey>& kept_places) {
+  // `renamed` holds the kept pieces (into the surface's refs).
+  void run_outside(const TerrainTree::Impl::Region& kept, const std::unordered_set<SlotKey>& kept_places,
+                   std::vector<SurfacePieces::Piece> renamed) {
+    gathered_ = std::move(renamed);
     kept_ = kept;
     kept_places_ = kept_places;
     skip_kept_ = true;
@@ -200,15 +203,12 @@ class Distributor {
     }
   }
 
-  // Sorts the pieces by slot (stable: in the order they came) and fits the storage.
+  // Keeps the pieces by slot (stable: in the order they came) and fits the storage.
   void finish() {
-    std::stable_sort(s_.pieces.begin(), s_.pieces.end(),
-                     [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
+    s_.keep(gathered_);
     s_.vertices.shrink_to_fit();
     s_.colors.shrink_to_fit();
     s_.tcoords.shrink_to_fit();
-    s_.pieces.shrink_to_fit();
-    s_.refs.shrink_to_fit();
   }
 
   // What to do with a polygon (pool_[first .. first + count)): kChain: the window's boundary
@@ -298,7 +298,7 @@ class Distributor {
   }
 
   void arrive(SlotKey slot, std::uint32_t first, std::uint32_t count) {
-    s_.pieces.push_back({slot, static_cast<std::uint32_t>(s_.refs.size()), count});
+    gathered_.push_back({slot, static_cast<std::uint32_t>(s_.refs.size()), count});
     s_.refs.insert(s_.refs.end(), pool_.begin() + first, pool_.begin() + first + count);
   }
 
@@ -431,6 +431,7 @@ class Distributor {
 
   const TerrainTree::Impl& m_;
   SurfacePieces& s_;
+  std::vector<SurfacePieces::Piece> gathered_;  // kept by finish()
   double eps_ = 0.0;
   bool skip_kept_ = false;
   TerrainTree::Impl::Region kept_;
@@ -914,10 +915,12 @@ class SlotBuilder {
           std::uint32_t v = ids_[p.first + k];
           if (!(v & kTerrainRef)) {
             if (remap[v] == std::numeric_limits<std::uint32_t>::max()) {
-              remap[v] = static_cast<std::uint32_t>(out_.positions.size());
-              out_.positions.emplace_back(pos_[v]);
-              out_.colors.push_back(col_[v]);
-              if (m_.has_tcoords) out_.tcoords.push_back(tc_[v]);
+              if (!out_.staged) out_.staged = std::make_unique<StagedVertices>();
+              StagedVertices& staged = *out_.staged;
+              remap[v] = static_cast<std::uint32_t>(staged.positions.size());
+              staged.positions.emplace_back(pos_[v]);
+              staged.colors.push_back(col_[v]);
+              if (m_.has_tcoords) staged.tcoords.push_back(tc_[v]);
               out_.top = std::max(out_.top, static_cast<float>(pos_[v].z));
             }
             v = remap[v];
@@ -978,13 +981,6 @@ void release(std::vector<T>& v) {
 
 bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
 
-// The pieces of surface `s` that arrived at slot `key`.
-std::pair<const SurfacePieces::Piece*, const SurfacePieces::Piece*> arrivals(const SurfacePieces& s, SlotKey key) {
-  const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{key, 0, 0},
-                                      [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
-  return {s.pieces.data() + (range.first - s.pieces.begin()), s.pieces.data() + (range.second - s.pieces.begin())};
-}
-
 // Removes the polygons of the surfaces in `ids` (sorted) from a store; returns the references
 // dropped with them. Its top becomes that of what stays.
 std::size_t remove_surfaces(BspStore& st, const std::vector<std::uint32_t>& ids, const std::vector<glm::vec3>& positions) {
@@ -1037,24 +1033,26 @@ void ContentIndex::build(std::size_t cells, const std::vector<std::uint32_t>& so
 
 void TerrainTree::Impl::flush(BspStore& st) {
   const auto base = static_cast<std::uint32_t>(positions.size());
-  if (positions.capacity() < positions.size() + st.positions.size()) {
-    // Grown by a quarter, not doubled: lazily built slots arrive one by one.
-    const std::size_t want = std::max(positions.size() + st.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
-    positions.reserve(want);
-    merged_colors.reserve(want - merged_base());
-    if (has_tcoords) merged_tcoords.reserve(want - merged_base());
+  if (st.staged) {
+    const StagedVertices& staged = *st.staged;
+    if (positions.capacity() < positions.size() + staged.positions.size()) {
+      // Grown by a quarter, not doubled: lazily built slots arrive one by one.
+      const std::size_t want =
+          std::max(positions.size() + staged.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
+      positions.reserve(want);
+      merged_colors.reserve(want - merged_base());
+      if (has_tcoords) merged_tcoords.reserve(want - merged_base());
+    }
+    positions.insert(positions.end(), staged.positions.begin(), staged.positions.end());
+    merged_colors.insert(merged_colors.end(), staged.colors.begin(), staged.colors.end());
+    merged_tcoords.insert(merged_tcoords.end(), staged.tcoords.begin(), staged.tcoords.end());
   }
-  positions.insert(positions.end(), st.positions.begin(), st.positions.end());
-  merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
-  merged_tcoords.insert(merged_tcoords.end(), st.tcoords.begin(), st.tcoords.end());
   for (std::size_t r = st.staged_refs; r < st.refs.size(); ++r) {
     const std::uint32_t v = st.refs[r];
     st.refs[r] = (v & kTerrainRef) ? (v & ~kTerrainRef) : base + v;
   }
   st.staged_refs = static_cast<std::uint32_t>(st.refs.size());
-  release(st.positions);
-  release(st.colors);
-  release(st.tcoords);
+  st.staged.reset();
 }
 
 void TerrainTree::Impl::compact() {
@@ -1163,10 +1161,10 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     slot.pending = 0;
     slot.top = -1e30f;
     for (const auto& [id, s] : surfaces) {
-      for (auto [it, end] = arrivals(s, key); it != end; ++it) {
+      s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) {
         ++slot.pending;
-        for (std::uint32_t r = 0; r < it->count; ++r) slot.top = std::max(slot.top, static_cast<float>(s.vertices[s.refs[it->first + r]].z));
-      }
+        for (std::uint32_t r : piece) slot.top = std::max(slot.top, static_cast<float>(s.vertices[r].z));
+      });
     }
     if (slot.pending == 0) {  // nothing left here
       removed[k] = slot.refs();
@@ -1185,7 +1183,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     SlotBuilder builder(*this, *slot.store);
     for (const auto& [id, s] : surfaces) {
       if (!anew && !std::binary_search(changed.begin(), changed.end(), id)) continue;
-      for (auto [it, end] = arrivals(s, key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+      s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
     }
     if (is_low(key)) {
       const CellName c = cell_name(*this, key / 2);
@@ -1216,12 +1214,12 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   merge_stats.rebuilt_slots += touched.size();
   for (std::size_t r : removed) dead_refs += r;
   std::size_t staged = 0;
-  for (const Slot& slot : slots) staged += slot.store ? slot.store->positions.size() : 0;
+  for (const Slot& slot : slots) staged += slot.store ? slot.store->staged_count() : 0;
   positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
   merged_colors.reserve(merged_colors.size() + staged);
   if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
   for (Slot& slot : slots) {
-    if (slot.store && (!slot.store->positions.empty() || slot.store->staged_refs < slot.store->refs.size())) flush(*slot.store);
+    if (slot.store && (slot.store->staged || slot.store->staged_refs < slot.store->refs.size())) flush(*slot.store);
   }
   std::size_t live = 0;
   for (const Slot& slot : slots) live += slot.refs();
@@ -1255,7 +1253,7 @@ void TerrainTree::Impl::build_pending(std::size_t k) {
   slot.store = std::make_unique<BspStore>();
   SlotBuilder builder(*this, *slot.store);
   for (const auto& [id, s] : surfaces) {
-    for (auto [it, end] = arrivals(s, slot.key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+    s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
   }
   const CellName c = cell_name(*this, slot.key / 2);
   builder.build_low(c.level, c.ci, c.cj);
@@ -1289,8 +1287,7 @@ void check_surface(const SurfaceInput& s) {
 }
 
 void keys_of(const SurfacePieces& s, std::vector<SlotKey>& out) {
-  for (const auto& p : s.pieces)
-    if (out.empty() || out.back() != p.slot) out.push_back(p.slot);
+  for (const SurfacePieces::Run& run : s.runs) out.push_back(run.slot);
 }
 
 }  // namespace
@@ -1381,15 +1378,16 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
     SurfacePieces& s = surfaces[k].second;
     std::vector<SurfacePieces::Piece> pieces;
     std::vector<std::uint32_t> refs;
-    for (const SurfacePieces::Piece& p : s.pieces) {
-      const std::optional<SlotKey> key = renamed(p.slot);
+    for (std::size_t r = 0; r < s.runs.size(); ++r) {
+      const std::optional<SlotKey> key = renamed(s.runs[r].slot);
       if (!key) continue;
-      pieces.push_back({*key, static_cast<std::uint32_t>(refs.size()), p.count});
-      refs.insert(refs.end(), s.refs.begin() + p.first, s.refs.begin() + p.first + p.count);
+      s.for_each_in_run(r, [&](std::span<const std::uint32_t> piece) {
+        pieces.push_back({*key, static_cast<std::uint32_t>(refs.size()), static_cast<std::uint32_t>(piece.size())});
+        refs.insert(refs.end(), piece.begin(), piece.end());
+      });
     }
-    s.pieces = std::move(pieces);
     s.refs = std::move(refs);
-    Distributor(*this, s).run_outside(kept, kept_places);
+    Distributor(*this, s).run_outside(kept, kept_places, std::move(pieces));
     std::vector<std::uint32_t> remap(s.vertices.size(), 0);
     for (std::uint32_t r : s.refs) remap[r] = 1;
     std::uint32_t used = 0;
@@ -1415,10 +1413,9 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   std::vector<std::uint32_t> ids;
   for (const auto& [id, s] : surfaces) {
     ids.push_back(id);
-    for (const SurfacePieces::Piece& p : s.pieces) {
-      if (!touched.empty() && touched.back() == p.slot) continue;
-      const auto at = std::lower_bound(slots.begin(), slots.end(), p.slot, [](const Slot& a, SlotKey b) { return a.key < b; });
-      if (at == slots.end() || at->key != p.slot) touched.push_back(p.slot);
+    for (const SurfacePieces::Run& run : s.runs) {
+      const auto at = std::lower_bound(slots.begin(), slots.end(), run.slot, [](const Slot& a, SlotKey b) { return a.key < b; });
+      if (at == slots.end() || at->key != run.slot) touched.push_back(run.slot);
     }
   }
   ++merged_version;  // the lattice vertices moved

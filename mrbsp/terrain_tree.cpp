@@ -241,14 +241,16 @@ std::size_t held(const std::vector<T>& v) {
 }  // namespace
 
 std::size_t BspStore::bytes() const {
-  return held(nodes) + held(boxes) + held(polys) + held(refs) + held(positions) + held(colors);
+  std::size_t n = held(nodes) + held(boxes) + held(polys) + held(refs);
+  if (staged) n += sizeof(StagedVertices) + held(staged->positions) + held(staged->colors) + held(staged->tcoords);
+  return n;
 }
 
 void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
   const auto at = [&](std::uint32_t r) -> const glm::vec3& {
     const std::uint32_t v = refs[r];
     if (r < staged_refs) return where[v];
-    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
+    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : staged->positions[v];
   };
   // The store's bounds first: the grid the nodes' boxes are rounded to.
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
@@ -256,14 +258,23 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
     lo = glm::min(lo, glm::dvec3(at(r)));
     hi = glm::max(hi, glm::dvec3(at(r)));
   }
-  box_base = lo;
-  box_step = glm::max((hi - lo) / 65535.0, glm::dvec3(1e-9));
+  // In single precision, the base rounded down and the step up (twice, for the base's
+  // rounding), so that 65535 steps from the base reach past the highest vertex.
+  for (int a = 0; a < 3; ++a) {
+    float b = static_cast<float>(lo[a]);
+    if (b > lo[a]) b = std::nextafter(b, -std::numeric_limits<float>::infinity());
+    float step = static_cast<float>(std::max((hi[a] - b) / 65535.0, 1e-9));
+    step = std::nextafter(std::nextafter(step, std::numeric_limits<float>::infinity()), std::numeric_limits<float>::infinity());
+    box_base[a] = b;
+    box_step[a] = step;
+  }
+  const glm::dvec3 base(box_base), step(box_step);
   const auto down = [&](const glm::vec3& p) {
-    const glm::dvec3 q = glm::floor((glm::dvec3(p) - box_base) / box_step);
+    const glm::dvec3 q = glm::floor((glm::dvec3(p) - base) / step);
     return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
   };
   const auto up = [&](const glm::vec3& p) {
-    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - box_base) / box_step);
+    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - base) / step);
     return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
   };
   boxes.assign(nodes.size(), NodeBox{});
@@ -295,7 +306,26 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
 }
 
 std::size_t SurfacePieces::bytes() const {
-  return held(triangles) + held(vertices) + held(colors) + held(pieces) + held(refs);
+  return held(triangles) + held(vertices) + held(colors) + held(tcoords) + held(runs) + held(counts) + held(refs);
+}
+
+void SurfacePieces::keep(std::vector<Piece>& gathered) {
+  std::stable_sort(gathered.begin(), gathered.end(), [](const Piece& a, const Piece& b) { return a.slot < b.slot; });
+  std::vector<std::uint32_t> sorted;
+  sorted.reserve(refs.size());
+  runs.clear();
+  std::vector<std::uint16_t>().swap(counts);
+  counts.reserve(gathered.size());
+  for (const Piece& p : gathered) {
+    if (p.count > 0xFFFFu) throw std::length_error("SurfacePieces::keep: a piece of " + std::to_string(p.count) + " vertices");
+    if (runs.empty() || runs.back().slot != p.slot) {
+      runs.push_back({p.slot, static_cast<std::uint32_t>(counts.size()), static_cast<std::uint32_t>(sorted.size())});
+    }
+    counts.push_back(static_cast<std::uint16_t>(p.count));
+    sorted.insert(sorted.end(), refs.begin() + p.first, refs.begin() + p.first + p.count);
+  }
+  refs = std::move(sorted);
+  runs.shrink_to_fit();
 }
 
 MemoryStats TerrainTree::memory() const {
@@ -936,8 +966,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         const NodeBox& box = store.boxes[static_cast<std::size_t>(node)];
         if (box.lo[0] > box.hi[0]) return;  // holds nothing
         // Outward in double, then to floats rounded outward again: the box still holds the subtree.
-        const glm::dvec3 lo = store.box_base + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * store.box_step;
-        const glm::dvec3 hi = store.box_base + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * store.box_step;
+        const glm::dvec3 lo = glm::dvec3(store.box_base) + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * glm::dvec3(store.box_step);
+        const glm::dvec3 hi = glm::dvec3(store.box_base) + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * glm::dvec3(store.box_step);
         const glm::vec3 flo(std::nextafter(static_cast<float>(lo.x), -INFINITY), std::nextafter(static_cast<float>(lo.y), -INFINITY),
                             std::nextafter(static_cast<float>(lo.z), -INFINITY));
         const glm::vec3 fhi(std::nextafter(static_cast<float>(hi.x), INFINITY), std::nextafter(static_cast<float>(hi.y), INFINITY),

@@ -12,10 +12,12 @@
 // triangles) and its children (the high alternative).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -70,25 +72,33 @@ struct NodeBox {
 };
 inline constexpr std::int32_t kDropSide = -2;
 
+// Vertices made while a small BSP is built, before Impl::flush() moves them into the tree's
+// merged vertices.
+struct StagedVertices {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::u8vec4> colors;
+  std::vector<glm::vec2> tcoords;
+};
+
 // The small BSP of one slot: nodes, polygons and references (indices into positions()). New
-// vertices are staged in `positions` and `colors`, with the references made since
-// `staged_refs` pointing into them, until Impl::flush() moves them into the tree's merged
-// vertices and makes those references global.
+// vertices are staged (`staged`), with the references made since `staged_refs` pointing into
+// them, until Impl::flush() moves them into the tree's merged vertices, makes those references
+// global and lets `staged` go. Kept small: there is one per built slot (17,763 in the
+// benchmark scene).
 struct BspStore {
   std::vector<BspNode> nodes;
   std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
-  glm::dvec3 box_base{0.0}, box_step{1.0};  // the boxes' grid: the store's bounds in 65535 steps
+  glm::vec3 box_base{0.0f}, box_step{1.0f};  // the boxes' grid: the store's bounds in at most 65535 steps
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
-  std::vector<glm::vec3> positions;  // staged, empty once flushed
-  std::vector<glm::u8vec4> colors;
-  std::vector<glm::vec2> tcoords;
+  std::unique_ptr<StagedVertices> staged;  // null when nothing is staged
   std::uint32_t staged_refs = 0;
   std::int32_t root = -1;
-  std::size_t pieces = 0;   // merged polygons (terrain triangles not counted)
-  std::size_t dropped = 0;  // pieces found below the low triangles and dropped
-  float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
+  std::uint32_t pieces = 0;   // merged polygons (terrain triangles not counted)
+  std::uint32_t dropped = 0;  // pieces found below the low triangles and dropped
+  float top = -1e30f;         // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
+  std::size_t staged_count() const { return staged ? staged->positions.size() : 0; }
   // Sets every node's subtree box (boxes, box_base, box_step) from its polygons' vertices: references
   // into `where` (the tree's positions()), and those made since staged_refs as staged (before
   // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
@@ -150,8 +160,8 @@ struct CellContent {
 };
 
 // One surface's polygons after distribution through the tree's planes (merge.cpp): pieces
-// arrived at slots, in the order they were made. Vertices are the input's followed by those
-// made by splitting (double precision, for classification).
+// arrived at slots, kept by slot and in the order they were made within a slot. Vertices are
+// the input's followed by those made by splitting (double precision, for classification).
 struct SurfacePieces {
   std::size_t input_triangles = 0;
   std::size_t input_vertices = 0;           // the first vertices are the input's
@@ -159,16 +169,42 @@ struct SurfacePieces {
   std::vector<glm::dvec3> vertices;
   std::vector<glm::u8vec4> colors;
   std::vector<glm::vec2> tcoords;  // empty, or one per vertex
+  // A piece while pieces are gathered (Distributor): its `count` references from refs[first].
   struct Piece {
     SlotKey slot;
-    std::uint32_t first;  // into refs
+    std::uint32_t first;
     std::uint32_t count;
   };
-  static_assert(sizeof(Piece) == 12);
-  std::vector<Piece> pieces;  // sorted by slot, stable
+  // The pieces kept, 2 bytes each rather than a Piece's 12 (most of them wait in low slots
+  // never built): run k is the pieces [runs[k].piece0, runs[k + 1].piece0) of slot
+  // runs[k].slot (runs sorted by slot), their references one after the other in `refs` from
+  // runs[k].ref0, counts[p] of them for piece p.
+  struct Run {
+    SlotKey slot;
+    std::uint32_t piece0, ref0;
+  };
+  std::vector<Run> runs;
+  std::vector<std::uint16_t> counts;
   std::vector<std::uint32_t> refs;
   std::size_t dropped = 0;  // pieces found below the terrain and dropped
   std::size_t bytes() const;
+  std::size_t piece_count() const { return counts.size(); }
+  // Calls f(std::span<const std::uint32_t>) with the references of each piece of run k.
+  template <class F>
+  void for_each_in_run(std::size_t k, F&& f) const {
+    const std::uint32_t end = k + 1 < runs.size() ? runs[k + 1].piece0 : static_cast<std::uint32_t>(counts.size());
+    const std::uint32_t* r = refs.data() + runs[k].ref0;
+    for (std::uint32_t p = runs[k].piece0; p < end; r += counts[p], ++p) f(std::span<const std::uint32_t>(r, counts[p]));
+  }
+  // The same for the pieces that arrived at slot `key` (none when none did).
+  template <class F>
+  void for_each_arrival(SlotKey key, F&& f) const {
+    const auto at = std::lower_bound(runs.begin(), runs.end(), key, [](const Run& a, SlotKey b) { return a.slot < b; });
+    if (at != runs.end() && at->slot == key) for_each_in_run(static_cast<std::size_t>(at - runs.begin()), f);
+  }
+  // Keeps `gathered` (pieces into refs, in any order): sorted by slot (stable), refs reordered
+  // to match. Throws std::length_error for a piece of more than 65535 vertices.
+  void keep(std::vector<Piece>& gathered);
 };
 
 // A slot and its small BSP. Above and outside slots are built when merged; low slots only
