@@ -302,6 +302,7 @@ struct ColumnModel::State {
   std::vector<double> x, y;
   std::vector<KnifeEdge> edges;
   std::optional<ItmPath> itm;
+  std::vector<double> losses;  // ITM's losses of one column
 
   // x, y for a profile (both models: Deygout's terrain, and the departure's geometry).
   void raise(const TerrainProfile& profile) {
@@ -399,12 +400,10 @@ std::size_t ColumnModel::path_loss(const TerrainProfile& profile, std::span<cons
     }
     s.itm->set_profile(profile.ground_m, distance / static_cast<double>(n - 1), s.tx.height_agl);
     if (!s.tx.antenna) {
-      // ITM's own loss; the pattern's geometry is not needed.
-      for (std::size_t k = 0; k < heights.size(); ++k) {
-        const ItmLoss r = s.itm->loss(heights[k]);
-        out[k] = static_cast<float>(r.loss_db);
-        if (r.warning >= 3) ++warned;
-      }
+      // ITM's own loss, all heights at once; the pattern's geometry is not needed.
+      s.losses.resize(heights.size());
+      warned = s.itm->losses(heights, s.losses);
+      for (std::size_t k = 0; k < heights.size(); ++k) out[k] = static_cast<float>(s.losses[k]);
       return warned;
     }
   }

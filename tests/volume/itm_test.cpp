@@ -148,11 +148,13 @@ TEST(ItmReference, MatchesNtiaPublishedPointToPointCases) {
 }
 
 // ItmPath, which shares the profile's work between the heights of a column (horizons from an
-// envelope, prefix sums, Delta h kept and its quantiles guessed, the transmitter's terms kept),
-// against the straightforward evaluation of each point on its own: random profiles from flat
-// to mountainous, short to troposcatter range, every climate, both polarizations, all four
-// variability modes, the heights of a column in rising order (as terravol rf runs them), then
-// again in random order.
+// envelope, prefix sums, Delta h kept and its quantiles guessed) and evaluates the rest of the
+// chain four heights at a time with its own exponential and logarithm (itm_kernel.h), against
+// the straightforward evaluation of each point on its own: random profiles from flat to
+// mountainous, short to troposcatter range, every climate, both polarizations, all four
+// variability modes; the heights of a column at once (as terravol rf runs them, on both copies
+// of the kernel, and equal to loss() height by height), then one by one in rising and in random
+// order.
 TEST(ItmFastPath, EqualsTheStraightforwardEvaluationOfEachPoint) {
   std::mt19937 rng(190419);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -192,6 +194,19 @@ TEST(ItmFastPath, EqualsTheStraightforwardEvaluationOfEachPoint) {
     shuffled.insert(shuffled.begin(), heights.begin(), heights.end());
     ItmPath path(f, p);
     path.set_profile(z, spacing, tx);
+    // The column at once (as terravol rf runs it) on both copies of the kernel, which agree
+    // to the bit.
+    std::vector<double> column(heights.size()), baseline(heights.size());
+    path.losses(heights, column);
+    itm_detail::force_baseline_kernel(true);
+    path.losses(heights, baseline);
+    itm_detail::force_baseline_kernel(false);
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      ASSERT_TRUE(column[k] == baseline[k] || (std::isnan(column[k]) && std::isnan(baseline[k])))
+          << "trial " << trial << ": " << column[k] << " (" << itm_detail::kernel_name() << ") against " << baseline[k];
+      const ItmLoss one = path.loss(heights[k]);
+      ASSERT_TRUE(column[k] == one.loss_db || (std::isnan(column[k]) && std::isnan(one.loss_db))) << "trial " << trial;
+    }
     for (const double h : shuffled) {
       const ItmLoss fast = path.loss(h);
       const reference::ReferenceLoss plain = reference::itm_reference(z, spacing, tx, h, f, p);
