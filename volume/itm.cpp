@@ -141,6 +141,23 @@ constexpr Climate kClimates[7] = {
      {8.43, 8.19, 136.2e3, 188.5e3, 122.9e3}, 1.518, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
 };
 
+namespace kernel = itm_kernel::baseline;
+
+std::atomic<bool> baseline_forced{false};
+
+// The kernel of this processor: AVX2 where it has it (and the operating system saves its
+// registers), else the baseline one; the same values either way.
+bool use_avx2() { return __builtin_cpu_supports("avx2") && !baseline_forced.load(std::memory_order_relaxed); }
+
+void evaluate(const itm_kernel::Path& path, itm_kernel::Lanes& lanes) {
+  if (use_avx2()) {
+    itm_kernel::avx2::evaluate(path, lanes);
+  } else {
+    kernel::evaluate(path, lanes);
+  }
+}
+
+
 // A line fitted by least squares, with the trapezoidal rule's weights (half at both ends), to
 // samples ja..jb (unit spacing) given their sums: the Algorithm's fit of a line to a profile.
 struct Line {
@@ -221,116 +238,69 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
   const int n = 10 * ka - 5;
   const auto size = static_cast<std::size_t>(n);
-  w.samples.resize(size);
-  w.low.resize(size);
-  w.high.resize(size);
+  constexpr auto kParts = static_cast<std::size_t>(itm_kernel::kSumParts);
+  w.samples.resize((size + kParts - 1) / kParts * kParts);
+  w.low.resize(size + kParts);
+  w.high.resize(size + kParts);
+  w.spare.resize(size + kParts);
   double* s = w.samples.data();
   // Linear interpolation at n equally spaced points p from xa to xb, each on the interval that
-  // ends at sample k = ceil(p), within [floor(xa) + 1, np] (p >= 0 here, so ceil(p) is the
-  // truncation plus one unless p is whole); the sums for the line, in order.
+  // ends at sample k = ceil(p), within [floor(xa) + 1, np]; the sums for the line.
   const double step = (xb - xa) / (n - 1);
   const int k0 = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
-  double sum = 0.0, sum_i = 0.0, jd = 0.0;
-  int j = 0;
-#if defined(__SSE2__)
-  // Two points at a time, with the same operations as the scalar loop below.
-  {
-    const __m128d xa2 = _mm_set1_pd(xa), step2 = _mm_set1_pd(step), one = _mm_set1_pd(1.0);
-    const __m128d two = _mm_set1_pd(2.0), lo = _mm_set1_pd(k0), hi = _mm_set1_pd(np);
-    __m128d j2 = _mm_set_pd(1.0, 0.0);
-    for (; j + 1 < n; j += 2, j2 = _mm_add_pd(j2, two)) {
-      const __m128d p = _mm_add_pd(xa2, _mm_mul_pd(j2, step2));
-      __m128d k = _mm_cvtepi32_pd(_mm_cvttpd_epi32(p));
-      k = _mm_add_pd(k, _mm_and_pd(_mm_cmplt_pd(k, p), one));
-      k = _mm_min_pd(hi, _mm_max_pd(lo, k));
-      const __m128i ki = _mm_cvttpd_epi32(k);
-      const int ka0 = _mm_cvtsi128_si32(ki), ka1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(ki, 1));
-      const __m128d zk = _mm_loadh_pd(_mm_load_sd(z + ka0), z + ka1);
-      const __m128d zm = _mm_loadh_pd(_mm_load_sd(z + ka0 - 1), z + ka1 - 1);
-      const __m128d v = _mm_add_pd(zk, _mm_mul_pd(_mm_sub_pd(zk, zm), _mm_sub_pd(p, k)));
-      _mm_storeu_pd(s + j, v);
-      const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
-      sum += v0;
-      sum_i += jd * v0;
-      jd += 1.0;
-      sum += v1;
-      sum_i += jd * v1;
-      jd += 1.0;
-    }
-  }
-#endif
-  for (; j < n; ++j, jd += 1.0) {
-    const double p = xa + j * step;
-    int k = static_cast<int>(p);
-    k += k < p ? 1 : 0;
-    k = std::min(np, std::max(k0, k));
-    const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
-    s[j] = v;
-    sum += v;
-    sum_i += jd * v;
-  }
+  const bool avx2 = use_avx2();
+  const itm_kernel::Sums sums = avx2 ? itm_kernel::avx2::resample(z, np, k0, xa, step, n, s)
+                                     : kernel::resample(z, np, k0, xa, step, n, s);
+  const double sum = sums.sum, sum_i = sums.sum_i;
   const Line line = trapezoid_fit(sum, sum_i, s[0], s[n - 1], 0, n - 1);
   const double at0 = line.at(0.0), slope = line.slope;
   // The ka-th smallest and the ka-th largest deviation from the line. Their candidates are
-  // gathered in the same pass: the deviations beyond thresholds a little inside the last ones
-  // found; when too few, again with thresholds 4, 16 and 64 times farther in, then all. Exact
-  // whatever the guess: it only decides how much is gathered. Deviation i is
-  // s[i] - (at0 + slope i), computed alike wherever it is needed.
+  // gathered in one pass: the deviations beyond thresholds a margin inside the last ones
+  // found, each side's margin (a fraction of their distance) grown after a miss and shrunk
+  // after a haul much larger than needed; a side with too few gathers again with its margin 4,
+  // 16 and 64 times wider, then all. Exact whatever the guess: it only decides how much is
+  // gathered. Deviation i is s[i] - (at0 + slope i), computed alike wherever it is needed.
   const auto rank = static_cast<std::size_t>(ka - 1);
   const bool guessed = std::isfinite(w.lower) && std::isfinite(w.upper) && w.upper > w.lower;
-  const double margin = guessed ? 0.02 * (w.upper - w.lower) : 0.0;
+  const double range = guessed ? w.upper - w.lower : 0.0;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double* low = w.low.data();
   double* high = w.high.data();
+  double* spare = w.spare.data();  // where a side that has enough gathers nothing
+  auto beyond = [&](bool redo_low, double low_threshold, bool redo_high, double high_threshold) {
+    const double lt = redo_low ? low_threshold : -kInf, ht = redo_high ? high_threshold : kInf;
+    double* l = redo_low ? low : spare;
+    double* h = redo_high ? high : spare;
+    return avx2 ? itm_kernel::avx2::beyond(s, n, at0, slope, lt, ht, l, h) : kernel::beyond(s, n, at0, slope, lt, ht, l, h);
+  };
   std::size_t n_low = 0, n_high = 0;
   if (guessed) {
-    const double low_threshold = w.lower + margin, high_threshold = w.upper - margin;
-    int i = 0;
-#if defined(__SSE2__)
-    {
-      const __m128d at2 = _mm_set1_pd(at0), slope2 = _mm_set1_pd(slope), two = _mm_set1_pd(2.0);
-      const __m128d lt = _mm_set1_pd(low_threshold), ht = _mm_set1_pd(high_threshold);
-      __m128d i2 = _mm_set_pd(1.0, 0.0);
-      for (; i + 1 < n; i += 2, i2 = _mm_add_pd(i2, two)) {
-        const __m128d r = _mm_sub_pd(_mm_loadu_pd(s + i), _mm_add_pd(at2, _mm_mul_pd(slope2, i2)));
-        const int below = _mm_movemask_pd(_mm_cmple_pd(r, lt)), above = _mm_movemask_pd(_mm_cmpge_pd(r, ht));
-        const double r0 = _mm_cvtsd_f64(r), r1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
-        low[n_low] = r0;
-        n_low += static_cast<std::size_t>(below & 1);
-        low[n_low] = r1;
-        n_low += static_cast<std::size_t>(below >> 1);
-        high[n_high] = r0;
-        n_high += static_cast<std::size_t>(above & 1);
-        high[n_high] = r1;
-        n_high += static_cast<std::size_t>(above >> 1);
+    const itm_kernel::Counts c = beyond(true, w.lower + w.low_margin * range, true, w.upper - w.high_margin * range);
+    n_low = c.low;
+    n_high = c.high;
+    auto adapt = [&](double& margin, std::size_t count) {
+      if (count <= rank) {
+        margin = std::min(2.0 * margin, 0.5);
+      } else if (count > rank + 6) {
+        margin = std::max(0.75 * margin, 0.002);
       }
-    }
-#endif
-    for (double id = i; i < n; ++i, id += 1.0) {
-      const double r = s[i] - (at0 + slope * id);
-      low[n_low] = r;
-      n_low += r <= low_threshold ? 1 : 0;
-      high[n_high] = r;
-      n_high += r >= high_threshold ? 1 : 0;
+    };
+    adapt(w.low_margin, n_low);
+    adapt(w.high_margin, n_high);
+    for (double widen = 4.0; widen <= 64.0 && (n_low <= rank || n_high <= rank); widen *= 4.0) {
+      const bool redo_low = n_low <= rank, redo_high = n_high <= rank;
+      const itm_kernel::Counts again =
+          beyond(redo_low, w.lower + widen * w.low_margin * range, redo_high, w.upper - widen * w.high_margin * range);
+      if (redo_low) n_low = again.low;
+      if (redo_high) n_high = again.high;
     }
   }
-  // One side again, below threshold (sign 1) or above it (sign -1); everything when not finite.
-  auto regather = [&](double* c, double sign, double threshold) {
-    std::size_t count = 0;
-    double id = 0.0;
-    for (int i = 0; i < n; ++i, id += 1.0) {
-      const double r = s[i] - (at0 + slope * id);
-      c[count] = r;
-      count += sign * r <= sign * threshold ? 1 : 0;
-    }
-    return count;
-  };
-  for (double widen = 4.0; widen <= 64.0 && guessed; widen *= 4.0) {
-    if (n_low <= rank) n_low = regather(low, 1.0, w.lower + widen * margin);
-    if (n_high <= rank) n_high = regather(high, -1.0, w.upper - widen * margin);
+  if (n_low <= rank || n_high <= rank) {
+    const bool redo_low = n_low <= rank, redo_high = n_high <= rank;
+    const itm_kernel::Counts all = beyond(redo_low, kInf, redo_high, -kInf);
+    if (redo_low) n_low = all.low;
+    if (redo_high) n_high = all.high;
   }
-  if (n_low <= rank) n_low = regather(low, 1.0, kInf);
-  if (n_high <= rank) n_high = regather(high, -1.0, -kInf);
   const double lower = kth_extreme<false>(low, n_low, rank);
   const double upper = kth_extreme<true>(high, n_high, rank);
   w.lower = lower;
@@ -338,31 +308,21 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
-namespace kernel = itm_kernel::baseline;
-
-std::atomic<bool> baseline_forced{false};
-
-// The kernel of this processor: AVX2 where it has it (and the operating system saves its
-// registers), else the baseline one; the same values either way.
-void evaluate(const itm_kernel::Path& path, itm_kernel::Lanes& lanes) {
-  if (__builtin_cpu_supports("avx2") && !baseline_forced.load(std::memory_order_relaxed)) {
-    itm_kernel::avx2::evaluate(path, lanes);
-  } else {
-    kernel::evaluate(path, lanes);
-  }
-}
-
-
 }  // namespace
 
 namespace itm_kernel::baseline {
 void evaluate(const Path& p, Lanes& lanes) { evaluate_lanes(p, lanes); }
+Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s) {
+  return resample_lanes(z, np, k0, xa, step, n, s);
+}
+Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
+              double* high) {
+  return beyond_lanes(s, n, at0, slope, low_threshold, high_threshold, low, high);
+}
 }  // namespace itm_kernel::baseline
 
 namespace itm_detail {
-std::string kernel_name() {
-  return __builtin_cpu_supports("avx2") && !baseline_forced.load(std::memory_order_relaxed) ? "avx2" : "baseline";
-}
+std::string kernel_name() { return use_avx2() ? "avx2" : "baseline"; }
 void force_baseline_kernel(bool force) { baseline_forced.store(force, std::memory_order_relaxed); }
 }  // namespace itm_detail
 

@@ -83,11 +83,13 @@ struct ItmLoss {
   double horizon_angle_rad[2] = {0, 0};  // elevation of each horizon ray
 };
 
-// Scratch space of the terrain irregularity: the resampled profile, and the last quantiles
-// found (a guess for the next, which only decides how fast they are found).
+// Scratch space of the terrain irregularity: the resampled profile, the candidates for its
+// quantiles, and the last quantiles found with the margins to search within (a guess for the
+// next, which only decides how fast they are found).
 struct DeltaHScratch {
-  std::vector<double> samples, low, high;
+  std::vector<double> samples, low, high, spare;
   double lower = std::nan(""), upper = std::nan("");
+  double low_margin = 0.02, high_margin = 0.02;  // fractions of upper - lower
 };
 
 namespace itm_kernel {

@@ -16,12 +16,14 @@
 // all of them.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
 namespace terravol::volume::itm_kernel {
 
-inline constexpr int kLanes = 4;
+inline constexpr int kLanes = 4;  // receiver heights per evaluation
+inline constexpr int kSumParts = 4;  // Delta h's running sums
 
 // What does not change between the heights of one path.
 struct Path {
@@ -56,13 +58,34 @@ struct Lanes {
   double warning[kLanes] = {};
 };
 
-// The lanes' losses (Lanes' "out" fields) from their geometry: each instruction set's copy.
+// Delta h's resampling (itm.cpp's delta_h_of): n points p_j = xa + j step, xa >= 0 and the
+// last at most np, each interpolated linearly on the interval that ends at sample k = ceil(p_j)
+// clamped to [k0, np], into s (room for n rounded up to kSumParts; the spare places get 0);
+// and the sums of the values and of j times the values, each summed in kSumParts parts (part
+// l the points j = l mod kSumParts, in order), the parts added pairwise at the end.
+struct Sums {
+  double sum = 0.0, sum_i = 0.0;
+};
+// The deviations s_j - (at0 + slope j) of s[0..n) at or below low_threshold into low and at or
+// above high_threshold into high, in any order (room for n + kSumParts each); their counts.
+struct Counts {
+  std::size_t low = 0, high = 0;
+};
+
+// Each instruction set's copy: the lanes' losses (Lanes' "out" fields) from their geometry,
+// and Delta h's two passes.
 namespace baseline {
 void evaluate(const Path& p, Lanes& lanes);
-}
+Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s);
+Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
+              double* high);
+}  // namespace baseline
 namespace avx2 {
 void evaluate(const Path& p, Lanes& lanes);
-}
+Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s);
+Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
+              double* high);
+}  // namespace avx2
 
 }  // namespace terravol::volume::itm_kernel
 
@@ -113,8 +136,15 @@ inline V vabs(V x) { return from_bits(bits(x) & (I{} + 0x7fffffffffffffffLL)); }
 
 inline V vsqrt(V x) {
 #if defined(__AVX__)
-  static_assert(kLanes == 4);
-  return __builtin_bit_cast(V, _mm256_sqrt_pd(__builtin_bit_cast(__m256d, x)));
+  static_assert(kLanes % 4 == 0);
+  V out;
+  for (int k = 0; k < kLanes; k += 4) {
+    __m256d part;
+    __builtin_memcpy(&part, reinterpret_cast<const double*>(&x) + k, sizeof part);
+    part = _mm256_sqrt_pd(part);
+    __builtin_memcpy(reinterpret_cast<double*>(&out) + k, &part, sizeof part);
+  }
+  return out;
 #elif defined(__SSE2__)
   static_assert(kLanes % 2 == 0);
   V out;
@@ -175,7 +205,10 @@ inline V vlog(V x) {
   const I subnormal = x < splat(kMinNormal);
   const V xs = select(subnormal, x * splat(18014398509481984.0), x);  // 2^54
   const I offset = bits(xs) - (I{} + 0x3fe6a09e667f3bcdLL);           // the bits of sqrt(1/2)
-  const I e = offset >> 52;
+  // offset >> 52 with its sign (a logical shift of the 12-bit field, then sign-extended:
+  // AVX2 has no arithmetic shift of 64-bit lanes).
+  using U = std::uint64_t __attribute__((vector_size(8 * kLanes)));
+  const I e = ((I)((U)offset >> 52) ^ 0x800) - 0x800;
   const V m = from_bits(bits(xs) - (e << 52));
   V ed = from_bits(e + bits(splat(kRoundShift))) - splat(kRoundShift);
   ed = select(subnormal, ed - splat(54.0), ed);
@@ -562,6 +595,106 @@ inline void evaluate_lanes(const Path& p, Lanes& lanes) {
     store(lanes.dl[j], dl[j]);
     store(lanes.the[j], the[j]);
   }
+}
+
+// Delta h's passes, four points at a time.
+using Q = double __attribute__((vector_size(8 * kSumParts)));
+using QI = std::int64_t __attribute__((vector_size(8 * kSumParts)));
+inline Q qsplat(double x) { return Q{} + x; }
+inline QI qbits(Q x) {
+  QI i;
+  __builtin_memcpy(&i, &x, sizeof i);
+  return i;
+}
+inline Q qload(const double* p) {
+  Q v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline Q lane_numbers() {
+  Q v;
+  for (int l = 0; l < kSumParts; ++l) v[l] = l;
+  return v;
+}
+
+inline Sums resample_lanes(const double* z, int np, int k0, double xa, double step, int n, double* s) {
+  const Q lo = qsplat(k0), hi = qsplat(np), count = qsplat(n), first = lane_numbers(), shift = qsplat(kRoundShift);
+  Q sum = qsplat(0.0), sum_i = qsplat(0.0);
+  for (int j = 0; j < n; j += kSumParts) {
+    const Q jv = qsplat(j) + first;
+    const Q p = qsplat(xa) + jv * qsplat(step);
+    Q k = (p + shift) - shift;        // p rounded to a whole number
+    k = k < p ? k + qsplat(1.0) : k;  // up
+    k = k < lo ? lo : k;
+    k = hi < k ? hi : k;
+    const QI index = qbits(k + shift) - qbits(shift);
+#if defined(__AVX2__)
+    // Each lane's two samples in one load, then the lanes' first and second halves together.
+    static_assert(kSumParts == 4);
+    const __m128d p0 = _mm_loadu_pd(z + index[0] - 1), p1 = _mm_loadu_pd(z + index[1] - 1);
+    const __m128d p2 = _mm_loadu_pd(z + index[2] - 1), p3 = _mm_loadu_pd(z + index[3] - 1);
+    const __m256d a = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // z[k0-1] z[k0] z[k2-1] z[k2]
+    const __m256d b = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);
+    const Q zm = __builtin_bit_cast(Q, _mm256_unpacklo_pd(a, b));  // z[k0-1] z[k1-1] z[k2-1] z[k3-1]
+    const Q zk = __builtin_bit_cast(Q, _mm256_unpackhi_pd(a, b));
+#else
+    Q zk, zm;
+    for (int l = 0; l < kSumParts; ++l) {
+      zk[l] = z[index[l]];
+      zm[l] = z[index[l] - 1];
+    }
+#endif
+    const Q v = jv < count ? zk + (zk - zm) * (p - k) : qsplat(0.0);
+    __builtin_memcpy(s + j, &v, sizeof v);
+    sum = sum + v;
+    sum_i = sum_i + jv * v;
+  }
+  Sums out;
+  for (int l = 0; l < kSumParts; l += 2) {
+    out.sum += sum[l] + sum[l + 1];
+    out.sum_i += sum_i[l] + sum_i[l + 1];
+  }
+  return out;
+}
+
+inline Counts beyond_lanes(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold,
+                           double* low, double* high) {
+  const Q first = lane_numbers(), lt = qsplat(low_threshold), ht = qsplat(high_threshold), count = qsplat(n);
+  Counts c;
+  for (int j = 0; j < n; j += kSumParts) {
+    const Q jv = qsplat(j) + first;
+    const Q r = qload(s + j) - (qsplat(at0) + qsplat(slope) * jv);
+    const QI inside = jv < count;
+    const QI below = inside & (r <= lt), above = inside & (r >= ht);
+#if defined(__AVX2__)
+    // Each side's lanes moved to the front (a permutation per 4-bit mask), stored whole, the
+    // count advanced by how many there were.
+    static_assert(kSumParts == 4);
+    static constexpr int kOrder[16][8] = {
+        {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7}, {2, 3, 0, 1, 4, 5, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7},
+        {4, 5, 0, 1, 2, 3, 6, 7}, {0, 1, 4, 5, 2, 3, 6, 7}, {2, 3, 4, 5, 0, 1, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7},
+        {6, 7, 0, 1, 2, 3, 4, 5}, {0, 1, 6, 7, 2, 3, 4, 5}, {2, 3, 6, 7, 0, 1, 4, 5}, {0, 1, 2, 3, 6, 7, 4, 5},
+        {4, 5, 6, 7, 0, 1, 2, 3}, {0, 1, 4, 5, 6, 7, 2, 3}, {2, 3, 4, 5, 6, 7, 0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}};
+    static constexpr std::size_t kCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+    const __m256 values = __builtin_bit_cast(__m256, r);
+    auto put = [&](QI mask, double* out, std::size_t& n_out) {
+      const int m = _mm256_movemask_pd(__builtin_bit_cast(__m256d, mask));
+      const __m256i order = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kOrder[m]));
+      _mm256_storeu_ps(reinterpret_cast<float*>(out + n_out), _mm256_permutevar8x32_ps(values, order));
+      n_out += kCount[m];
+    };
+    put(below, low, c.low);
+    put(above, high, c.high);
+#else
+    for (int l = 0; l < kSumParts; ++l) {
+      low[c.low] = r[l];
+      c.low += below[l] != 0 ? 1 : 0;
+      high[c.high] = r[l];
+      c.high += above[l] != 0 ? 1 : 0;
+    }
+#endif
+  }
+  return c;
 }
 
 }  // namespace terravol::volume::itm_kernel::TERRAVOL_ITM_KERNEL
