@@ -324,6 +324,18 @@ Counts beyond(const double* s, int n, double at0, double slope, double low_thres
 namespace itm_detail {
 std::string kernel_name() { return use_avx2() ? "avx2" : "baseline"; }
 void force_baseline_kernel(bool force) { baseline_forced.store(force, std::memory_order_relaxed); }
+double kernel_exp(double x) { return kernel::vexp(kernel::splat(x))[0]; }
+double kernel_log(double x) { return kernel::vlog(kernel::splat(x))[0]; }
+double kernel_cbrt(double x) {
+  kernel::V ln_root;
+  return kernel::vcbrt(kernel::splat(x), ln_root)[0];
+}
+void kernel_sincos(double x, double& sine, double& cosine) {
+  kernel::V s, c;
+  kernel::vsincos(kernel::splat(x), s, c);
+  sine = s[0];
+  cosine = c[0];
+}
 }  // namespace itm_detail
 
 int ItmParameters::mdvar() const {
@@ -422,23 +434,35 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   gme_ = kGammaA * (1.0 - 0.04665 * std::exp(ns_ / 179.3));
 
   // Horizon terms: elevation angles on the Earth of curvature gamma_e (heights relative to the
-  // terminal, less the drop qc s^2 of the curved Earth, over the distance s).
+  // terminal, less the drop qc s^2 of the curved Earth, over the distance s). 1 / s from a
+  // table of 1 / i (kept between profiles), without a division per sample.
   const double qc = 0.5 * gme_;
   const double za = z_[0] + hg_tx_;
+  const auto samples = static_cast<std::size_t>(n_) + 1;
+  for (std::size_t i = std::max<std::size_t>(inverse_.size(), 1); i < samples; ++i) {
+    if (inverse_.empty()) inverse_.push_back(0.0);
+    inverse_.push_back(1.0 / static_cast<double>(i));
+  }
+  rx_a_.resize(samples);
+  rx_u_.resize(samples);
+  tx_angle_.resize(samples);
+  const double inverse_xi = 1.0 / xi_;
+  for (int i = 1; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double z = z_[k];
+    const double s = i * xi_, sb = dist_ - s;
+    const double inverse_sb = inverse_xi * inverse_[static_cast<std::size_t>(n_ - i)];
+    tx_angle_[k] = (z - za) * (inverse_xi * inverse_[k]) - qc * s;
+    rx_a_[k] = z * inverse_sb - qc * sb;
+    rx_u_[k] = inverse_sb;
+  }
   tx_best_angle_ = -std::numeric_limits<double>::infinity();
   tx_best_distance_ = dist_;
-  rx_a_.resize(static_cast<std::size_t>(n_) + 1);
-  rx_u_.resize(static_cast<std::size_t>(n_) + 1);
   for (int i = 1; i < n_; ++i) {
-    const double z = z_[static_cast<std::size_t>(i)];
-    const double s = i * xi_, sb = dist_ - s;
-    const double angle = (z - za) / s - qc * s;
-    if (angle > tx_best_angle_) {
-      tx_best_angle_ = angle;
-      tx_best_distance_ = s;
+    if (tx_angle_[static_cast<std::size_t>(i)] > tx_best_angle_) {
+      tx_best_angle_ = tx_angle_[static_cast<std::size_t>(i)];
+      tx_best_distance_ = i * xi_;
     }
-    rx_a_[static_cast<std::size_t>(i)] = z / sb - qc * sb;
-    rx_u_[static_cast<std::size_t>(i)] = 1.0 / sb;
   }
   dh_x1_ = dh_x2_ = -1.0;
   rx_hull_built_ = false;
@@ -549,6 +573,7 @@ void ItmPath::kernel_path(itm_kernel::Path& k) const {
   k.zg_re = zg_re_;
   k.zg_im = zg_im_;
   k.inverse_abs_zg = inverse_abs_zg_;
+  k.ln_inverse_abs_zg = std::log(inverse_abs_zg_);
   k.dist = dist_;
   k.ln_dist = std::log(dist_);
   k.hg_tx = hg_tx_;

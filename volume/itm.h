@@ -103,6 +103,12 @@ namespace itm_detail {
 std::string kernel_name();
 // For tests: run the baseline copy even where AVX2 is there (false, the default: the best one).
 void force_baseline_kernel(bool force);
+// For tests: the kernel's own exponential, logarithm, cube root, sine and cosine (x within
+// [0, pi]) of one value.
+double kernel_exp(double x);
+double kernel_log(double x);
+double kernel_cbrt(double x);
+void kernel_sincos(double x, double& sine, double& cosine);
 }  // namespace itm_detail
 
 // One path's terrain, to be evaluated for many receiver heights: what depends on the profile
@@ -151,6 +157,8 @@ class ItmPath {
   std::vector<double> sum_z_, sum_iz_;   // prefix sums of z_i and i z_i, for line fits
   std::vector<double> rx_a_, rx_u_;      // the receiver's horizon angle of sample i is
                                          // rx_a_[i] - z_rx * rx_u_[i]
+  std::vector<double> tx_angle_;         // the transmitter's horizon angle of sample i
+  std::vector<double> inverse_;          // 1 / i, as far as the longest profile yet
   // The upper envelope of those lines in z_rx (sample indices, from low z_rx to high; built
   // when a receiver first has a horizon), and the last query's place on it.
   std::vector<int> rx_hull_;

@@ -29,6 +29,7 @@ inline constexpr int kSumParts = 4;  // Delta h's running sums
 struct Path {
   double wn = 0.0, ens = 0.0, gme = 0.0, xae = 0.0;  // wave number, N_s, gamma_e, (k gamma_e^2)^(-1/3)
   double zg_re = 0.0, zg_im = 0.0, inverse_abs_zg = 0.0;  // ground impedance
+  double ln_inverse_abs_zg = 0.0;
   double dist = 0.0, ln_dist = 0.0, hg_tx = 0.0;  // ln_dist: ln(d / 1 m)
   double free_space_db = 0.0;
   double decay_d4 = 0.0;        // exp(-2.7574 X_ae / 50 km): exp(-d / 50 km) from d3 to d4
@@ -168,28 +169,33 @@ constexpr double kRoundShift = 6755399441055744.0;     // 1.5 * 2^52: x + it rou
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// c[0] + c[1] x + ... + c[9] x^9 and c[0] + ... + c[13] x^13 by Estrin's scheme (pairs, then
+// pairs of pairs with x^2, x^4, x^8): a few multiplications deep instead of one per term, for
+// the kernel's chains are long.
+inline V estrin10(V x, const double (&c)[10]) {
+  const V x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
+  auto pair = [&](int i) { return splat(c[i]) + splat(c[i + 1]) * x; };
+  return (pair(0) + pair(2) * x2) + (pair(4) + pair(6) * x2) * x4 + pair(8) * x8;
+}
+inline V estrin14(V x, const double (&c)[14]) {
+  const V x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
+  auto pair = [&](int i) { return splat(c[i]) + splat(c[i + 1]) * x; };
+  return ((pair(0) + pair(2) * x2) + (pair(4) + pair(6) * x2) * x4) +
+         ((pair(8) + pair(10) * x2) + pair(12) * x4) * x8;
+}
+
 // e^x to 2 units in the last place for x within [-708, 709]; 0 below, +inf above, NaN for NaN.
 // x = n ln 2 + r, |r| <= ln 2 / 2 (Cody and Waite's two-part ln 2), e^r by its Taylor series
 // to r^13 (the next term is below 2e-17 of it), times 2^n through the exponent bits.
 inline V vexp(V x) {
+  static constexpr double kTaylor[14] = {1.0,          1.0,           1.0 / 2,        1.0 / 6,         1.0 / 24,
+                                         1.0 / 120,    1.0 / 720,     1.0 / 5040,     1.0 / 40320,     1.0 / 362880,
+                                         1.0 / 3628800, 1.0 / 39916800, 1.0 / 479001600, 1.0 / 6227020800};
   const V xc = vmin(vmax(x, splat(-708.0)), splat(709.0));
   const V t = xc * splat(1.4426950408889634) + splat(kRoundShift);
   const V n = t - splat(kRoundShift);
   const V r = (xc - n * splat(kLn2Hi)) - n * splat(kLn2Lo);
-  V p = splat(1.0 / 6227020800.0);
-  p = p * r + splat(1.0 / 479001600.0);
-  p = p * r + splat(1.0 / 39916800.0);
-  p = p * r + splat(1.0 / 3628800.0);
-  p = p * r + splat(1.0 / 362880.0);
-  p = p * r + splat(1.0 / 40320.0);
-  p = p * r + splat(1.0 / 5040.0);
-  p = p * r + splat(1.0 / 720.0);
-  p = p * r + splat(1.0 / 120.0);
-  p = p * r + splat(1.0 / 24.0);
-  p = p * r + splat(1.0 / 6.0);
-  p = p * r + splat(0.5);
-  p = p * r + splat(1.0);
-  p = p * r + splat(1.0);
+  const V p = estrin14(r, kTaylor);
   const I ni = bits(t) - bits(splat(kRoundShift));
   V e = from_bits(bits(p) + (ni << 52));
   e = select(x < splat(-708.0), splat(0.0), e);
@@ -199,8 +205,10 @@ inline V vexp(V x) {
 
 // ln x to about 2e-16 absolute (x near 1) or 2 units in the last place; -inf at 0, NaN below 0
 // or for NaN, +inf at +inf. x = 2^e m, m within [sqrt(1/2), sqrt 2), ln m = 2 atanh(s) with
-// s = (m - 1) / (m + 1), |s| <= 0.1716, by its series to s^23.
+// s = (m - 1) / (m + 1), |s| <= 0.1716, by its series to s^21 (the next term is below 1e-17).
 inline V vlog(V x) {
+  static constexpr double kAtanh[10] = {2.0 / 3,  2.0 / 5,  2.0 / 7,  2.0 / 9,  2.0 / 11,
+                                        2.0 / 13, 2.0 / 15, 2.0 / 17, 2.0 / 19, 2.0 / 21};
   constexpr double kMinNormal = std::numeric_limits<double>::min();
   const I subnormal = x < splat(kMinNormal);
   const V xs = select(subnormal, x * splat(18014398509481984.0), x);  // 2^54
@@ -214,59 +222,33 @@ inline V vlog(V x) {
   ed = select(subnormal, ed - splat(54.0), ed);
   const V s = (m - splat(1.0)) / (m + splat(1.0));
   const V s2 = s * s;
-  V p = splat(2.0 / 23.0);
-  p = p * s2 + splat(2.0 / 21.0);
-  p = p * s2 + splat(2.0 / 19.0);
-  p = p * s2 + splat(2.0 / 17.0);
-  p = p * s2 + splat(2.0 / 15.0);
-  p = p * s2 + splat(2.0 / 13.0);
-  p = p * s2 + splat(2.0 / 11.0);
-  p = p * s2 + splat(2.0 / 9.0);
-  p = p * s2 + splat(2.0 / 7.0);
-  p = p * s2 + splat(2.0 / 5.0);
-  p = p * s2 + splat(2.0 / 3.0);
-  const V ln_m = s * splat(2.0) + p * s2 * s;
+  const V ln_m = s * splat(2.0) + estrin10(s2, kAtanh) * s2 * s;
   V out = ed * splat(kLn2Hi) + (ln_m + ed * splat(kLn2Lo));
   out = select(x == splat(kInf), x, out);
   out = select(x == splat(0.0), splat(-kInf), out);
   return select((x < splat(0.0)) | (x != x), splat(kNaN), out);
 }
 
-// x^(1/3) and x^(-1/3) for x > 0, from the logarithm (relative error under 1e-15 either).
-inline void vcbrt(V x, V& cube_root, V& inverse) {
-  const V third = vlog(x) * splat(1.0 / 3.0);
-  cube_root = vexp(third);
-  inverse = vexp(-third);
+// x^(1/3) (relative error under 1e-15) and its logarithm, for x > 0.
+inline V vcbrt(V x, V& ln_cube_root) {
+  ln_cube_root = vlog(x) * splat(1.0 / 3.0);
+  return vexp(ln_cube_root);
 }
 
 // sin and cos of x within [0, pi] (ITM's phase difference), to about 2e-16 absolute: of
 // y = x - pi/2 within [-pi/2, pi/2], cos x = -sin y and sin x = cos y by their Taylor series
 // (the first terms left out are below 2e-17).
 inline void vsincos(V x, V& sine, V& cosine) {
+  static constexpr double kSin[10] = {-1.0 / 6,           1.0 / 120,           -1.0 / 5040,          1.0 / 362880,
+                                      -1.0 / 39916800,    1.0 / 6227020800,    -1.0 / 1307674368000, 1.0 / 355687428096000,
+                                      -1.0 / 121645100408832000, 1.0 / 51090942171709440000.0};
+  static constexpr double kCos[10] = {-1.0 / 2,           1.0 / 24,            -1.0 / 720,           1.0 / 40320,
+                                      -1.0 / 3628800,     1.0 / 479001600,     -1.0 / 87178291200,   1.0 / 20922789888000,
+                                      -1.0 / 6402373705728000, 1.0 / 2432902008176640000};
   const V y = (x - splat(1.5707963267948966)) - splat(6.123233995736766e-17);
   const V y2 = y * y;
-  V s = splat(-1.0 / 51090942171709440000.0);  // -1/21!... the series of sin y from y^21 down
-  s = s * y2 + splat(1.0 / 121645100408832000.0);
-  s = s * y2 - splat(1.0 / 355687428096000.0);
-  s = s * y2 + splat(1.0 / 1307674368000.0);
-  s = s * y2 - splat(1.0 / 6227020800.0);
-  s = s * y2 + splat(1.0 / 39916800.0);
-  s = s * y2 - splat(1.0 / 362880.0);
-  s = s * y2 + splat(1.0 / 5040.0);
-  s = s * y2 - splat(1.0 / 120.0);
-  s = s * y2 + splat(1.0 / 6.0);
-  const V sin_y = y - s * y2 * y;
-  V c = splat(1.0 / 2432902008176640000.0);  // the series of cos y from y^20 down
-  c = c * y2 - splat(1.0 / 6402373705728000.0);
-  c = c * y2 + splat(1.0 / 20922789888000.0);
-  c = c * y2 - splat(1.0 / 87178291200.0);
-  c = c * y2 + splat(1.0 / 479001600.0);
-  c = c * y2 - splat(1.0 / 3628800.0);
-  c = c * y2 + splat(1.0 / 40320.0);
-  c = c * y2 - splat(1.0 / 720.0);
-  c = c * y2 + splat(1.0 / 24.0);
-  c = c * y2 - splat(0.5);
-  const V cos_y = splat(1.0) + c * y2;
+  const V sin_y = y + estrin10(y2, kSin) * y2 * y;
+  const V cos_y = splat(1.0) + estrin10(y2, kCos) * y2;
   sine = cos_y;
   cosine = -sin_y;
 }
@@ -278,9 +260,10 @@ inline V sigma_h(V dh) { return splat(0.78) * dh * vexp(-vsqrt(vsqrt(dh * splat(
 
 // F(v) of one knife edge from v^2 (the Algorithm's 6.1).
 inline V knife_edge(V v2) {
+  const I near = v2 < splat(5.76);
   const V low = splat(6.02) + splat(9.11) * vsqrt(v2) - splat(1.27) * v2;
-  const V high = splat(12.953) + splat(4.343) * vlog(v2);
-  return select(v2 < splat(5.76), low, high);
+  if (!any(~near)) return low;
+  return select(near, low, splat(12.953) + splat(4.343) * vlog(v2));
 }
 
 // The smooth-Earth height-gain F(x, K) (6.2-6.7), from ln x and ln K.
@@ -290,10 +273,11 @@ inline V height_gain(V x, V k, V ln_x, V ln_k) {
   const V small = splat(2.5e-5) * x * x / k - splat(8.686) * w - splat(15.0);
   const V below = select((k < splat(1e-5)) | (x * w * w * w > splat(5495.0)), flat, small);
   const V f = splat(0.05751) * x - splat(4.343) * ln_x;
+  const I near = x < splat(200.0), mixed_range = ~near & (x < splat(2000.0));
+  if (!any(mixed_range)) return select(near, below, f);
   const V wg = splat(0.0134) * x * vexp(splat(-0.005) * x);
   const V mixed = (splat(1.0) - wg) * f + wg * (splat(17.372) * ln_x - splat(117.0));
-  const V above = select(x < splat(2000.0), mixed, f);
-  return select(x < splat(200.0), below, above);
+  return select(near, below, select(mixed_range, mixed, f));
 }
 
 // The troposcatter frequency gain H_0(r, eta_s) (6.13) for eta_s >= 1.
@@ -342,11 +326,11 @@ inline Terminal terminal(V dl, V he, V dls, const Path& p) {
   Terminal t;
   t.dls = dls;
   const V a = splat(0.5) * dl * dl / he;  // the horizon's radius
-  V wa, inverse_wa;
-  vcbrt(a * splat(p.wn), wa, inverse_wa);
-  const V pk = splat(p.inverse_abs_zg) * inverse_wa;
+  V ln_wa;
+  const V wa = vcbrt(a * splat(p.wn), ln_wa);
+  const V pk = splat(p.inverse_abs_zg) / wa;
   t.x = (splat(1.607) - pk) * splat(151.0) * wa * dl / a;
-  t.gain = height_gain(t.x, pk, vlog(t.x), vlog(pk));
+  t.gain = height_gain(t.x, pk, vlog(t.x), splat(p.ln_inverse_abs_zg) - ln_wa);
   t.dexa = vsqrt(splat(18e6) * he);
   return t;
 }
@@ -411,9 +395,9 @@ inline void evaluate_lanes(const Path& p, Lanes& lanes) {
     const V v2 = splat(0.0795775) * wn * ds * th * th;  // 1 / (4 pi)
     const V knife = knife_edge(v2 * dl[0] / (ds + dl[0])) + knife_edge(v2 * dl[1] / (ds + dl[1]));
     const V a = ds / th;
-    V wa, inverse_wa;
-    vcbrt(a * wn, wa, inverse_wa);
-    const V pk = splat(p.inverse_abs_zg) * inverse_wa;
+    V ln_wa;
+    const V wa = vcbrt(a * wn, ln_wa);
+    const V pk = splat(p.inverse_abs_zg) / wa;
     const V x = (splat(1.607) - pk) * splat(151.0) * wa * th + xht;
     const V rounded = splat(0.05751) * x - splat(4.343) * vlog(x) - aht;
     const V q = (wd1 + xd1 / d) * vmin(delta_h_over(decay, dh) * wn, splat(6283.2));
