@@ -181,7 +181,11 @@ Line trapezoid_fit(double sum_z, double sum_iz, double z_first, double z_last, i
 // end at 0.9 or 0.1 of a horizon distance that is a multiple of ten samples): which way they
 // go must not depend on the direction the path was computed in.
 double snap(double x) {
-  const double r = std::round(x);
+  // The nearest whole number by adding and taking off 1.5 * 2^52 (the baseline instruction set
+  // has no rounding instruction, and std::round is a call); only |x| < 2^51 gets near one.
+  constexpr double kShift = 6755399441055744.0;
+  if (!(std::abs(x) < 2251799813685248.0)) return x;
+  const double r = (x + kShift) - kShift;
   return std::abs(x - r) < 1e-9 * std::max(1.0, std::abs(x)) ? r : x;
 }
 double in_samples(double x, double xi) { return snap(x / xi); }
@@ -419,11 +423,14 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   sum_z_.resize(size);
   sum_iz_.resize(size);
   sum_z_[0] = sum_iz_[0] = 0.0;
+  double sum = 0.0, sum_i = 0.0;  // running, so that no sum waits on a store and a load
   for (int i = 0; i <= n_; ++i) {
     const double z = z_[static_cast<std::size_t>(i)];
     if (!std::isfinite(z)) throw std::invalid_argument("ITM profile: sample " + std::to_string(i) + " is not finite");
-    sum_z_[static_cast<std::size_t>(i) + 1] = sum_z_[static_cast<std::size_t>(i)] + z;
-    sum_iz_[static_cast<std::size_t>(i) + 1] = sum_iz_[static_cast<std::size_t>(i)] + i * z;
+    sum += z;
+    sum_i += i * z;
+    sum_z_[static_cast<std::size_t>(i) + 1] = sum;
+    sum_iz_[static_cast<std::size_t>(i) + 1] = sum_i;
   }
   // N_s and gamma_e from the mean elevation of the middle 80% of the profile.
   const int p10 = static_cast<int>(0.1 * n_);
