@@ -1,13 +1,8 @@
 #include "io/mosaic.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstdint>
-#include <exception>
-#include <optional>
 #include <system_error>
-#include <thread>
 
 #include "io/compressed.h"
 #include "io/error.h"
@@ -209,22 +204,6 @@ const Grid& Mosaic::cache_insert(std::size_t tile, Grid grid) const {
   return *cache_.front().grid;
 }
 
-Grid Mosaic::load_tile(std::size_t i) const {
-  const MosaicTile& t = tiles_.at(i);
-  Grid g = read_geographic(t.path, options_);
-  if (g.rows != t.rows || g.cols != t.cols || std::abs(g.georef.x0 - t.georef.x0) > 0.01 * t.georef.dx ||
-      std::abs(g.georef.y0 - t.georef.y0) > 0.01 * t.georef.dy) {
-    throw FormatError(t.path.string(), "content (" + std::to_string(g.rows) + " x " + std::to_string(g.cols) +
-                                           " samples from " + fmt_deg(g.georef.y0) + ", " + fmt_deg(g.georef.x0) +
-                                           ") does not match the extent its name gives");
-  }
-  return g;
-}
-
-bool Mosaic::cached(std::size_t i) const {
-  return std::any_of(cache_.begin(), cache_.end(), [&](const Cached& c) { return c.tile == i; });
-}
-
 const Grid& Mosaic::tile_grid(std::size_t i) const {
   for (auto it = cache_.begin(); it != cache_.end(); ++it) {
     if (it->tile == i) {
@@ -232,68 +211,16 @@ const Grid& Mosaic::tile_grid(std::size_t i) const {
       return *cache_.front().grid;
     }
   }
-  Grid g = load_tile(i);
+  const MosaicTile& t = tiles_.at(i);
+  Grid g = read_geographic(t.path, options_);
   ++loads_;
+  if (g.rows != t.rows || g.cols != t.cols || std::abs(g.georef.x0 - t.georef.x0) > 0.01 * t.georef.dx ||
+      std::abs(g.georef.y0 - t.georef.y0) > 0.01 * t.georef.dy) {
+    throw FormatError(t.path.string(), "content (" + std::to_string(g.rows) + " x " + std::to_string(g.cols) +
+                                           " samples from " + fmt_deg(g.georef.y0) + ", " + fmt_deg(g.georef.x0) +
+                                           ") does not match the extent its name gives");
+  }
   return cache_insert(i, std::move(g));
-}
-
-std::vector<std::size_t> Mosaic::needed_tiles(int row0, int col0, int n_rows, int n_cols) const {
-  // read_window's order: a tile is read when it gives a sample no earlier tile gave.
-  std::vector<std::uint8_t> covered(static_cast<std::size_t>(n_rows) * static_cast<std::size_t>(n_cols), 0);
-  std::vector<std::size_t> needed;
-  for (std::size_t i = 0; i < tiles_.size(); ++i) {
-    const MosaicTile& t = tiles_[i];
-    const int r_begin = std::max(row0, t.row0), r_end = std::min(row0 + n_rows, t.row0 + t.rows);
-    const int c_begin = std::max(col0, t.col0), c_end = std::min(col0 + n_cols, t.col0 + t.cols);
-    if (r_begin >= r_end || c_begin >= c_end) continue;
-    bool gives = false;
-    for (int r = r_begin; r < r_end; ++r) {
-      std::uint8_t* row = covered.data() + static_cast<std::size_t>(r - row0) * static_cast<std::size_t>(n_cols);
-      for (int c = c_begin; c < c_end; ++c) {
-        gives = gives || row[c - col0] == 0;
-        row[c - col0] = 1;
-      }
-    }
-    if (gives) needed.push_back(i);
-  }
-  return needed;
-}
-
-void Mosaic::preload(const std::vector<std::size_t>& tiles) const {
-  std::vector<std::size_t> missing;
-  for (const std::size_t i : tiles) {
-    if (!cached(i)) missing.push_back(i);
-  }
-  // One decoder a tile, side by side, when there are several and the cache holds them all
-  // (otherwise read_window's own loads, one after the other).
-  const std::size_t workers = std::max(1u, std::thread::hardware_concurrency());
-  if (missing.size() < 2 || tiles.size() > cache_capacity_ || workers < 2) return;
-  for (const std::size_t i : tiles) {
-    if (cached(i)) tile_grid(i);  // to the front, so that the new ones evict only others
-  }
-  std::vector<std::optional<Grid>> grids(missing.size());
-  std::vector<std::exception_ptr> errors(missing.size());
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t k = next++; k < missing.size(); k = next++) {
-      try {
-        grids[k] = load_tile(missing[k]);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (std::size_t w = 1; w < std::min(workers, missing.size()); ++w) threads.emplace_back(work);
-  work();
-  for (std::thread& t : threads) t.join();
-  for (std::size_t k = 0; k < missing.size(); ++k) {
-    if (errors[k]) std::rethrow_exception(errors[k]);  // the first tile's failure, as one after the other
-  }
-  for (std::size_t k = 0; k < missing.size(); ++k) {
-    ++loads_;
-    cache_insert(missing[k], std::move(*grids[k]));
-  }
 }
 
 Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
@@ -304,7 +231,6 @@ Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
   out.georef.y0 = georef_.y0 - row0 * georef_.dy;
   out.allocate(n_rows, n_cols);
   std::fill(out.mask.begin(), out.mask.end(), Sample::kOutside);
-  preload(needed_tiles(row0, col0, n_rows, n_cols));
   for (std::size_t i = 0; i < tiles_.size(); ++i) {
     const MosaicTile& t = tiles_[i];
     const int r_begin = std::max(row0, t.row0), r_end = std::min(row0 + n_rows, t.row0 + t.rows);

@@ -59,9 +59,7 @@ class Mosaic {
   // The samples of rows [row0, row0 + n_rows) and columns [col0, col0 + n_cols) of the
   // lattice, voids marked kVoid (not filled) and samples no tile covers kOutside. The window
   // may extend past the mosaic (those samples are kOutside). Loads only the tiles it
-  // overlaps, several at once on as many threads when the cache holds them all (decoding a
-  // compressed tile takes a few tenths of a second). Throws FormatError for an empty or
-  // absurd window and for tiles that fail to load (the first in input order).
+  // overlaps. Throws FormatError for an empty or absurd window and for tiles that fail to load.
   Grid read_window(int row0, int col0, int n_rows, int n_cols) const;
 
   // Tile i decoded (geographic, voids marked), from the cache or loaded now.
@@ -84,12 +82,6 @@ class Mosaic {
   mutable std::list<Cached> cache_;  // most recently used first
   mutable std::size_t loads_ = 0;
   const Grid& cache_insert(std::size_t tile, Grid grid) const;
-  Grid load_tile(std::size_t i) const;  // decoded and checked against its extent; thread-safe
-  bool cached(std::size_t i) const;
-  // The tiles read_window reads for this window (those giving a sample no earlier tile gave).
-  std::vector<std::size_t> needed_tiles(int row0, int col0, int n_rows, int n_cols) const;
-  // Decodes those of `tiles` not in the cache side by side and caches them.
-  void preload(const std::vector<std::size_t>& tiles) const;
 };
 
 // Loads one DEM file as a geographic grid (read_dem, then to_geographic when projected).
