@@ -314,17 +314,6 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
 
 }  // namespace
 
-namespace itm_kernel::baseline {
-void evaluate(const Path& p, Lanes& lanes) { evaluate_lanes(p, lanes); }
-Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s) {
-  return resample_lanes(z, np, k0, xa, step, n, s);
-}
-Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
-              double* high) {
-  return beyond_lanes(s, n, at0, slope, low_threshold, high_threshold, low, high);
-}
-}  // namespace itm_kernel::baseline
-
 namespace itm_detail {
 std::string kernel_name() { return use_avx2() ? "avx2" : "baseline"; }
 void force_baseline_kernel(bool force) { baseline_forced.store(force, std::memory_order_relaxed); }

@@ -681,6 +681,17 @@ inline Counts beyond_lanes(const double* s, int n, double at0, double slope, dou
   return c;
 }
 
+// This copy's entry points (declared above); each file that includes this header with its
+// own TERRAVOL_ITM_KERNEL defines its copy's.
+void evaluate(const Path& p, Lanes& lanes) { evaluate_lanes(p, lanes); }
+Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s) {
+  return resample_lanes(z, np, k0, xa, step, n, s);
+}
+Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
+              double* high) {
+  return beyond_lanes(s, n, at0, slope, low_threshold, high_threshold, low, high);
+}
+
 }  // namespace terravol::volume::itm_kernel::TERRAVOL_ITM_KERNEL
 
 #pragma GCC diagnostic pop
