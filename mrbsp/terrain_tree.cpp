@@ -75,11 +75,14 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
       throw std::invalid_argument("TerrainTree: plane offsets must increase strictly");
     }
   }
+  // A window moved over the same terrain keeps what lies in both (section 4.3): the cell figures
+  // here, the merged content below.
+  const std::optional<std::pair<int, int>> shift = positions.empty() ? std::nullopt : shift_of(w);
   xs.assign(w.xs.begin(), w.xs.end());
   ys.assign(w.ys.begin(), w.ys.end());
   const auto zw = [&](int i, int j) { return w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
 
-  positions.resize(merged_base());
+  if (!shift) positions.resize(merged_base());  // merged vertices come again; kept after a shift
   float lowest = std::numeric_limits<float>::max();
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
@@ -96,12 +99,21 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   }
 
   // LOD cells above the finest: z range and error from their samples, independent of each
-  // other (TBB over the cells of each level).
+  // other (TBB over the cells of each level); after a shift, a cell in both windows keeps its
+  // figures (copied from where it was).
+  const std::vector<CellZ> before = shift ? cellz : std::vector<CellZ>{};
   for (int level = 0; level + 1 < levels; ++level) {
     const int s = cell_size(level), c = cells_at(level);
     CellZ* out = cellz.data() + cellz_offset[static_cast<std::size_t>(level + top)];
+    const CellZ* was = shift ? before.data() + cellz_offset[static_cast<std::size_t>(level + top)] : nullptr;
+    const int dci = shift ? shift->first / s : 0, dcj = shift ? shift->second / s : 0;
     tbb::parallel_for(tbb::blocked_range<int>(0, c * c, 64), [&](const tbb::blocked_range<int>& range) {
       for (int k = range.begin(); k != range.end(); ++k) {
+        const int oi = k % c + dci, oj = k / c + dcj;  // where the cell was
+        if (was && oi >= 0 && oj >= 0 && oi < c && oj < c) {
+          out[static_cast<std::size_t>(k)] = was[static_cast<std::size_t>(oj * c + oi)];
+          continue;
+        }
         const int i0 = (k % c) * s, j0 = (k / c) * s;
         const float zsw = zw(i0, j0), zse = zw(i0 + s, j0), zne = zw(i0 + s, j0 + s), znw = zw(i0, j0 + s);
         float zmin = std::numeric_limits<float>::max(), zmax = -zmin, err = 0.0f;
@@ -137,7 +149,46 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
         out[static_cast<std::size_t>(cj * c + ci)] = u;
       }
   }
-  redistribute_all();  // section 4.3: other objects are merged again into the moved tree
+  // Section 4.3: other objects are merged again into the moved tree; what lies in both windows
+  // stays.
+  if (shift) {
+    shift_merged(shift->first, shift->second);
+  } else {
+    redistribute_all();
+  }
+}
+
+double TerrainTree::Impl::band_plane(int side, int band) const {
+  const auto s0 = static_cast<std::size_t>(cell_size(0));
+  const std::vector<double>& lines = side < 2 ? xs : ys;
+  const double width = lines[s0] - lines[0];
+  return side % 2 == 0 ? lines.front() - band * width : lines.back() + band * width;
+}
+
+std::optional<std::pair<int, int>> TerrainTree::Impl::shift_of(const TerrainWindow& w) const {
+  // The moved window's first plane among this one's (or this one's among the moved one's).
+  const auto offset = [&](const std::vector<double>& old, std::span<const double> moved) -> std::optional<int> {
+    const auto in_old = std::lower_bound(old.begin(), old.end(), moved.front());
+    if (in_old != old.end() && *in_old == moved.front()) return static_cast<int>(in_old - old.begin());
+    const auto in_moved = std::lower_bound(moved.begin(), moved.end(), old.front());
+    if (in_moved != moved.end() && *in_moved == old.front()) return -static_cast<int>(in_moved - moved.begin());
+    return std::nullopt;
+  };
+  const std::optional<int> di = offset(xs, w.xs), dj = offset(ys, w.ys);
+  if (!di || !dj) return std::nullopt;
+  const int s0 = cell_size(0);
+  if (*di % s0 != 0 || *dj % s0 != 0 || std::abs(*di) >= n || std::abs(*dj) >= n) return std::nullopt;
+  // The same planes and heights wherever the two overlap.
+  const std::size_t side = static_cast<std::size_t>(n) + 1;
+  const int i0 = std::max(0, -*di), i1 = n - std::max(0, *di), j0 = std::max(0, -*dj), j1 = n - std::max(0, *dj);
+  for (int i = i0; i <= i1; ++i)
+    if (w.xs[static_cast<std::size_t>(i)] != xs[static_cast<std::size_t>(i + *di)]) return std::nullopt;
+  for (int j = j0; j <= j1; ++j)
+    if (w.ys[static_cast<std::size_t>(j)] != ys[static_cast<std::size_t>(j + *dj)]) return std::nullopt;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i)
+      if (w.z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)] != z(i + *di, j + *dj)) return std::nullopt;
+  return std::pair{*di, *dj};
 }
 
 TerrainTree::TerrainTree(const TerrainWindow& window, int levels) : impl_(std::make_unique<Impl>()) {
@@ -190,7 +241,57 @@ std::size_t held(const std::vector<T>& v) {
 }  // namespace
 
 std::size_t BspStore::bytes() const {
-  return held(nodes) + held(polys) + held(refs) + held(positions) + held(colors);
+  return held(nodes) + held(boxes) + held(polys) + held(refs) + held(positions) + held(colors);
+}
+
+void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
+  const auto at = [&](std::uint32_t r) -> const glm::vec3& {
+    const std::uint32_t v = refs[r];
+    if (r < staged_refs) return where[v];
+    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
+  };
+  // The store's bounds first: the grid the nodes' boxes are rounded to.
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (std::uint32_t r = 0; r < refs.size(); ++r) {
+    lo = glm::min(lo, glm::dvec3(at(r)));
+    hi = glm::max(hi, glm::dvec3(at(r)));
+  }
+  box_base = lo;
+  box_step = glm::max((hi - lo) / 65535.0, glm::dvec3(1e-9));
+  const auto down = [&](const glm::vec3& p) {
+    const glm::dvec3 q = glm::floor((glm::dvec3(p) - box_base) / box_step);
+    return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
+  };
+  const auto up = [&](const glm::vec3& p) {
+    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - box_base) / box_step);
+    return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
+  };
+  boxes.assign(nodes.size(), NodeBox{});
+  boxes.shrink_to_fit();
+  for (std::size_t k = nodes.size(); k-- > 0;) {
+    const BspNode& bn = nodes[k];
+    glm::dvec3 qlo(65536.0), qhi(-1.0);
+    for (std::uint32_t q = bn.first; q < bn.first + bn.count; ++q) {
+      const Polygon& p = polys[q];
+      for (std::uint32_t r = p.first; r < p.first + p.count; ++r) {
+        qlo = glm::min(qlo, down(at(r)));
+        qhi = glm::max(qhi, up(at(r)));
+      }
+    }
+    for (const std::int32_t child : {bn.back, bn.front}) {
+      if (child < 0) continue;  // none, or kDropSide
+      const NodeBox& c = boxes[static_cast<std::size_t>(child)];
+      if (c.lo[0] > c.hi[0]) continue;  // empty
+      qlo = glm::min(qlo, glm::dvec3(c.lo[0], c.lo[1], c.lo[2]));
+      qhi = glm::max(qhi, glm::dvec3(c.hi[0], c.hi[1], c.hi[2]));
+    }
+    if (qlo.x > qhi.x) continue;  // empty: stays lo > hi
+    NodeBox& b = boxes[k];
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = static_cast<std::uint16_t>(qlo[a]);
+      b.hi[a] = static_cast<std::uint16_t>(qhi[a]);
+    }
+  }
 }
 
 std::size_t SurfacePieces::bytes() const {
@@ -208,7 +309,7 @@ MemoryStats TerrainTree::memory() const {
   s.merged = held(m.positions) - s.vertices + held(m.merged_colors) + held(m.surfaces) + held(m.slots) +
              held(m.content_index.bits) + held(m.content_index.rank) + held(m.content) + held(m.top_content);
   for (const auto& [id, surface] : m.surfaces) s.merged += surface.bytes();
-  for (const Slot& slot : m.slots) s.merged += slot.store.bytes();
+  for (const Slot& slot : m.slots) s.merged += slot.store ? sizeof(BspStore) + slot.store->bytes() : 0;
   for (const auto& level : m.top_content) s.merged += held(level);
   return s;
 }
@@ -472,25 +573,47 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       stack.push_back(b2f ? near_item : far_item);
       stack.push_back(b2f ? far_item : near_item);
     };
-    // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
-    // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]). Built from the
-    // innermost out: the window, then each boundary plane's outside slot on the far or near
-    // side of what is inside it.
-    std::uint64_t order[5];
-    int count = 0;
-    order[count++] = pack(kSquare, 0, 0, 0);
+    // The window, inside the chain of its four boundary planes: beyond each lie the kOutside
+    // slots of one side (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]), in
+    // bands parallel to the plane. Built from the innermost out: the window, then each
+    // boundary plane's bands on the far or near side of what is inside it. A side's bands are
+    // slabs between parallel planes: back to front, those farther from the eye along the axis
+    // first (slabs on opposite sides of the eye cannot overlap on screen), the one holding the
+    // eye last.
+    auto& order = frame.outside_order_;
+    order.clear();
+    order.push_back(pack(kSquare, 0, 0, 0));
+    auto& places = frame.outside_places_;
     for (int side = 3; side >= 0; --side) {
-      if (m.outside[side] < 0) continue;
-      const std::uint64_t slot = pack_slot(m.outside[side]);
-      if (beyond[side] == b2f) {
-        order[count++] = slot;  // after everything inside
-      } else {
-        std::move_backward(order, order + count, order + count + 1);
-        order[0] = slot;
-        ++count;
+      const std::vector<std::int32_t>& slots = m.outside[static_cast<std::size_t>(side)];
+      if (slots.empty()) continue;
+      // Each place is a box: its band's slab across the side's axis, its column's along the
+      // other (south and north); sorted by the band's distance from the eye, then the column's.
+      const double eye_at = side < 2 ? e.x : e.y;
+      places.clear();
+      for (const std::int32_t slot : slots) {
+        const OutsidePlace p = outside_place(m.slots[static_cast<std::size_t>(slot)].key);
+        const double a = m.band_plane(side, p.band);
+        const double b = p.band + 1 < kBands ? m.band_plane(side, p.band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
+        double column_distance = 0.0;
+        if (side >= 2) {
+          const int s0 = m.cell_size(0);
+          const double x0 = m.xs[static_cast<std::size_t>(p.column * s0)], x1 = m.xs[static_cast<std::size_t>((p.column + 1) * s0)];
+          column_distance = e.x < x0 ? x0 - e.x : e.x > x1 ? e.x - x1 : 0.0;
+        }
+        const double lo = std::min(a, b), hi = std::max(a, b);
+        const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
+        places.push_back({band_distance, column_distance, slot});
       }
+      std::sort(places.begin(), places.end(), [&](const Frame::OutsideOrder& p, const Frame::OutsideOrder& q) {
+        if (p.band_distance != q.band_distance) return b2f ? p.band_distance > q.band_distance : p.band_distance < q.band_distance;
+        return b2f ? p.column_distance > q.column_distance : p.column_distance < q.column_distance;
+      });
+      for (const Frame::OutsideOrder& p : places) order.push_back(pack_slot(p.slot));
+      // After everything inside, or before it.
+      if (beyond[side] != b2f) std::rotate(order.begin(), order.end() - static_cast<std::ptrdiff_t>(places.size()), order.end());
     }
-    for (int k = count; k-- > 0;) stack.push_back(order[k]);
+    for (std::size_t k = order.size(); k-- > 0;) stack.push_back(order[k]);
     while (!stack.empty()) {
       const std::uint64_t item = stack.back();
       stack.pop_back();
@@ -798,17 +921,39 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     out[2] = c;
     frame.level[triangles++] = level;
   };
-  // A slot's small BSP: the far side of each plane first.
+  // A slot's small BSP: the far side of each plane first. With culling, a subtree whose box
+  // lies outside the view frustum is left out (GL would clip all of it away), each box tested
+  // only against the planes its parent's box straddles.
+  // Every slot emitted is built: above and outside slots when merged, low ones by pass 4.
   auto emit_store = [&](const BspStore& store) {
     auto& st = frame.leaf_stack_;
     st.clear();
-    if (store.root >= 0) st.push_back(store.root);
-    constexpr std::int32_t kEmitBit = std::int32_t{1} << 30;
+    // Items: node index, bit 31 set to emit the node's own polygons, bits 32-36 the planes left.
+    constexpr std::uint64_t kEmitBit = std::uint64_t{1} << 31;
+    const auto push_node = [&](std::int32_t node, int mask) {
+      if (node < 0) return;
+      if (options.cull && mask != 0) {
+        const NodeBox& box = store.boxes[static_cast<std::size_t>(node)];
+        if (box.lo[0] > box.hi[0]) return;  // holds nothing
+        // Outward in double, then to floats rounded outward again: the box still holds the subtree.
+        const glm::dvec3 lo = store.box_base + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * store.box_step;
+        const glm::dvec3 hi = store.box_base + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * store.box_step;
+        const glm::vec3 flo(std::nextafter(static_cast<float>(lo.x), -INFINITY), std::nextafter(static_cast<float>(lo.y), -INFINITY),
+                            std::nextafter(static_cast<float>(lo.z), -INFINITY));
+        const glm::vec3 fhi(std::nextafter(static_cast<float>(hi.x), INFINITY), std::nextafter(static_cast<float>(hi.y), INFINITY),
+                            std::nextafter(static_cast<float>(hi.z), INFINITY));
+        mask = box_planes(planes, flo, fhi, mask);
+        if (mask < 0) return;
+      }
+      st.push_back(static_cast<std::uint64_t>(node) | static_cast<std::uint64_t>(mask) << 32);
+    };
+    push_node(store.root, 31);
     while (!st.empty()) {
-      const std::int32_t top = st.back();
+      const std::uint64_t item = st.back();
       st.pop_back();
-      if (top & kEmitBit) {
-        const BspNode& bn = store.nodes[static_cast<std::size_t>(top & ~kEmitBit)];
+      const auto node = static_cast<std::size_t>(item & (kEmitBit - 1));
+      const BspNode& bn = store.nodes[node];
+      if (item & kEmitBit) {
         for (std::uint32_t k = 0; k < bn.count; ++k) {
           const Polygon& p = store.polys[bn.first + k];
           const std::uint32_t a = store.refs[p.first];
@@ -816,13 +961,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         }
         continue;
       }
-      const BspNode& bn = store.nodes[static_cast<std::size_t>(top)];
+      const int mask = static_cast<int>(item >> 32);
       const bool eye_front = glm::dot(glm::dvec3(bn.n), e) + static_cast<double>(bn.d) >= 0.0;
       const std::int32_t far_side = eye_front ? bn.back : bn.front, near_side = eye_front ? bn.front : bn.back;
       const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
-      if (second >= 0) st.push_back(second);
-      st.push_back(kEmitBit | top);
-      if (first >= 0) st.push_back(first);
+      push_node(second, mask);
+      st.push_back(kEmitBit | item);
+      push_node(first, mask);
     }
   };
   // A drawn cell's walls: on each window side the eye lies beyond and the cell touches, the
@@ -844,7 +989,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   };
   for (const std::uint64_t item : leaves) {
     if (kind_of(item) == kEmitSlot) {
-      emit_store(m.slots[static_cast<std::size_t>(slot_of(item))].store);
+      emit_store(*m.slots[static_cast<std::size_t>(slot_of(item))].store);
       continue;
     }
     const int level = level_index_of(item) - m.top;
@@ -870,7 +1015,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
 
     const CellContent* content = content_of(level, ci, cj);
     if (content && content->low >= 0) {
-      emit_store(m.slots[static_cast<std::size_t>(content->low)].store);
+      emit_store(*m.slots[static_cast<std::size_t>(content->low)].store);
     } else {
       // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
       const double side = (m.xs[static_cast<std::size_t>(i1)] - m.xs[static_cast<std::size_t>(i0)]) * (e.y - m.ys[static_cast<std::size_t>(j0)]) -

@@ -12,7 +12,11 @@
 // triangles) and its children (the high alternative).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -47,12 +51,22 @@ inline constexpr std::uint32_t kTerrainRef = 0x80000000u;
 // space below a low alternative's terrain triangle, where pieces are dropped). The plane is
 // kept in single precision (the pieces were split against it in double): it only tells the
 // eye's side, wrong at most for an eye within millimetres of it, where either order draws the
-// same.
+// same. 32 bytes: what a traversal reads at every node it passes; the node's box is in
+// BspStore::boxes.
 struct BspNode {
   glm::vec3 n{0.0f};
   float d = 0.0f;
   std::int32_t back = -1, front = -1;
   std::uint32_t first = 0, count = 0;  // into the store's polys
+};
+static_assert(sizeof(BspNode) == 32);
+
+// A box bounding every polygon of a node's subtree (its own and both sides', as drawn:
+// positions() floats), so that a traversal leaves out subtrees outside the view frustum: in
+// steps of BspStore::box_step from BspStore::box_base, rounded outward (lo down, hi up), so
+// that it holds the subtree; empty (lo > hi) when the subtree holds nothing. 12 bytes.
+struct NodeBox {
+  std::uint16_t lo[3] = {1, 1, 1}, hi[3] = {0, 0, 0};
 };
 inline constexpr std::int32_t kDropSide = -2;
 
@@ -62,6 +76,8 @@ inline constexpr std::int32_t kDropSide = -2;
 // vertices and makes those references global.
 struct BspStore {
   std::vector<BspNode> nodes;
+  std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
+  glm::dvec3 box_base{0.0}, box_step{1.0};  // the boxes' grid: the store's bounds in 65535 steps
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
   std::vector<glm::vec3> positions;  // staged, empty once flushed
@@ -73,6 +89,12 @@ struct BspStore {
   std::size_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
+  // Sets every node's subtree box (boxes, box_base, box_step) from its polygons' vertices: references
+  // into `where` (the tree's positions()), and those made since staged_refs as staged (before
+  // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
+  // their parents in `nodes` (build and insertion append them), so one pass from the last node
+  // up settles every box.
+  void bound_nodes(const std::vector<glm::vec3>& positions);
 };
 
 // Where merged polygons are kept. Per cell of level >= 0: kAbove holds the pieces of the
@@ -80,14 +102,32 @@ struct BspStore {
 // plane z = zmax: the eye's side of it is near), kLow the cell's low alternative: its two
 // terrain triangles and the pieces above them. Around the window, kOutside slots hold what
 // lies beyond its four boundary planes (west, east, south, north, in this order: a piece
-// beyond two belongs to the first).
+// beyond two belongs to the first), in bands one level-0 cell wide parallel to the plane: band
+// b of the west side lies between the planes x = xs[0] - (b + 1) w and x = xs[0] - b w (w the
+// level-0 cell's width), the last band (kBands - 1) everything beyond; south and north bands
+// lie between the west and east planes, cut further into the window's level-0 columns. A slide
+// by whole level-0 cells keeps most of them (Impl::shift_merged), and they are built apart (in
+// parallel, and none as large as all of a side).
 enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
+inline constexpr int kBands = 16;
+inline constexpr int kMaxColumns = 32768;  // level-0 columns of a window, at most
 
 // A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
-// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north). Cells number at most 1.5e9 (a
-// 32768-cell window), so keys fit 32 bits below kOutsideKey0.
+// outside_key(side, band, column) (side 0 west, 1 east, 2 south, 3 north; column 0 for west and
+// east). Cells number at most 1.5e9 (a 32768-cell window), so keys fit 32 bits below
+// kOutsideKey0.
 using SlotKey = std::uint32_t;
-inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFF0u;
+inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFFFu - 4u * kBands * kMaxColumns;
+inline constexpr SlotKey outside_key(int side, int band, int column) {
+  return kOutsideKey0 + static_cast<SlotKey>((side * kBands + band) * kMaxColumns + column);
+}
+struct OutsidePlace {
+  int side, band, column;
+};
+inline constexpr OutsidePlace outside_place(SlotKey key) {
+  const auto k = static_cast<int>(key - kOutsideKey0);
+  return {k / kMaxColumns / kBands, k / kMaxColumns % kBands, k % kMaxColumns};
+}
 
 // Which cells hold merged content, and where its record is: a bit per cell and the count of
 // set bits before each 64-bit word (rank), so a record is found in O(1) with 1.5 bits per cell.
@@ -140,7 +180,11 @@ struct Slot {
   bool built = false;
   std::size_t pending = 0;  // pieces arrived, while not built
   float top = 0.0f;         // highest vertex of the pieces arrived (the built store's is lower or equal)
-  BspStore store;
+  // Held apart (about 200 bytes of empty containers): most slots are low alternatives that are
+  // never built. Not null when built.
+  std::unique_ptr<BspStore> store;
+  // The store's, or 0 when there is none.
+  std::size_t refs() const { return store ? store->refs.size() : 0; }
 };
 
 struct TerrainTree::Impl {
@@ -164,7 +208,8 @@ struct TerrainTree::Impl {
   ContentIndex content_index;        // cells with content -> their record in `content`
   std::vector<CellContent> content;  // in cell id order
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
-  std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
+  // The kOutside slots (indices into slots) of each side.
+  std::array<std::vector<std::int32_t>, 4> outside;
   std::vector<glm::u8vec4> merged_colors;
   std::vector<glm::vec2> merged_tcoords;  // one per merged vertex while has_tcoords, else empty
   bool has_tcoords = false;               // some surface has texture coordinates
@@ -190,7 +235,29 @@ struct TerrainTree::Impl {
   // The figures of a cell at any level >= -top; the finest level's from its four samples.
   CellZ cell_z(int level, int ci, int cj) const;
 
+  // A rectangle of the lattice, samples [i0, i1] x [j0, j1] (window indices).
+  struct Region {
+    int i0 = 0, j0 = 0, i1 = -1, j1 = -1;
+    // Whether it holds the square of side s samples from (i, j).
+    bool holds(int i, int j, int s) const { return i >= i0 && j >= j0 && i + s <= i1 && j + s <= j1; }
+  };
+
+  // A new window (section 4.3). When it is this one moved by whole level-0 cells over the same
+  // terrain (the same plane offsets and heights where the two overlap: shift_of), what lies in
+  // both is kept: the overlap's cell figures, and its merged slots and pieces (shift_merged);
+  // the rest is computed anew.
   void refresh(const TerrainWindow& window);
+  // (di, dj) when `window` is this one moved by di columns and dj rows (multiples of the
+  // level-0 cell size, less than the window) over the same terrain; nothing otherwise.
+  std::optional<std::pair<int, int>> shift_of(const TerrainWindow& window) const;
+  // The plane offset where outside band `band` of `side` ends toward the window (band 0: the
+  // boundary plane itself) and its width (a level-0 cell's), along x for west and east, y for
+  // south and north.
+  double band_plane(int side, int band) const;
+  // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
+  // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the
+  // triangles reaching beyond the overlap merged into the rest of the window.
+  void shift_merged(int di, int dj);
   // Merging (merge.cpp). distribute() sends one surface's triangles through the tree;
   // rebuild() makes the slots whose keys are in `dirty` again from every surface's pieces,
   // then the cell content and the merged vertices.

@@ -262,6 +262,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   // buffer starts clear, so they show over the terrain in every draw order alike.
   window_->SetNumberOfLayers(2);
   labels_renderer_->SetLayer(1);
+  labels_renderer_->UseDepthPeelingOff();
   labels_renderer_->InteractiveOff();
   labels_renderer_->SetActiveCamera(renderer_->GetActiveCamera());
   labels_renderer_->DrawOff();  // until there are labels: no second pass over the window
@@ -531,33 +532,40 @@ void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) 
     t->SetColor(1.0, 1.0, 1.0);
     t->SetJustificationToCentered();
     t->SetVerticalJustificationToBottom();
+    // Drawn in the opaque pass, blended there: as translucent geometry VTK 9.1 would draw the
+    // layer with order-independent translucency, whose full-window buffers and passes cost
+    // about 15 ms per 1280x720 frame on llvmpipe for three labels. Labels lie over everything
+    // and never overlap the scene's translucency, so plain blending gives the same image.
+    a->ForceOpaqueOn();
     labels_renderer_->AddActor(a);
     labels_.push_back(a);
   }
 }
 
-void TerrainRenderer::set_legend(const scene::Legend& legend) {
-  legend_card_.reset();
-  legend_cache_ = {};
-  if (!legend.empty()) {
-    LegendCard card;
-    card.title = legend.title;
-    card.subtitle = legend.subtitle;
-    if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
-    card.lo = legend.lo;
-    card.hi = legend.hi;
-    // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
-    card.entries_title = legend.categories.empty() ? "isosurfaces"
-                         : legend.levels.empty()   ? legend.categories_title
-                                                   : legend.categories_title + ", isosurfaces";
-    for (const scene::LegendLevel& l : legend.categories) {
-      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
-    }
-    for (const scene::LegendLevel& l : legend.levels) {
-      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
-    }
-    legend_card_ = std::move(card);
+std::optional<LegendCard> legend_card(const scene::Legend& legend) {
+  if (legend.empty()) return std::nullopt;
+  LegendCard card;
+  card.title = legend.title;
+  card.subtitle = legend.subtitle;
+  if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
+  card.lo = legend.lo;
+  card.hi = legend.hi;
+  // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
+  card.entries_title = legend.categories.empty() ? "isosurfaces"
+                       : legend.levels.empty()   ? legend.categories_title
+                                                 : legend.categories_title + ", isosurfaces";
+  for (const scene::LegendLevel& l : legend.categories) {
+    card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
   }
+  for (const scene::LegendLevel& l : legend.levels) {
+    card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
+  }
+  return card;
+}
+
+void TerrainRenderer::set_legend(const scene::Legend& legend) {
+  legend_cache_ = {};
+  legend_card_ = legend_card(legend);
   legend_actor_->SetVisibility(false);
 }
 

@@ -139,8 +139,12 @@ SceneWindow read_scene_window(const io::Mosaic& mosaic, const WindowChoice& wind
 
   w.xs.resize(side);
   w.ys.resize(side);
-  for (int i = 0; i < side; ++i) w.xs[i] = frame.x_of_lon(w.bounds.west + i * g.dx);
-  for (int j = 0; j < side; ++j) w.ys[j] = frame.y_of_lat(w.bounds.south + j * g.dy);
+  // From the mosaic's own lattice (column col0 + i, row row0 + n - j from the north), not from
+  // the window's corner: a sample's plane offset is then the same double in every window
+  // holding it, so that a slide can find the samples two windows share and keep what lies on
+  // them (mrbsp::TerrainTree::slide).
+  for (int i = 0; i < side; ++i) w.xs[i] = frame.x_of_lon(g.x0 + (window.col0 + i) * g.dx);
+  for (int j = 0; j < side; ++j) w.ys[j] = frame.y_of_lat(g.y0 - (window.row0 + n - j) * g.dy);
   w.heights.resize(static_cast<std::size_t>(side) * side);
   w.z.resize(w.heights.size());
   w.min_z = std::numeric_limits<float>::max();

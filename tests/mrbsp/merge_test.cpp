@@ -27,10 +27,13 @@ struct Soup : test::TriangleSoup {
   }
 };
 
-// With `in_planes`, two more lie exactly in split planes; the area tests leave them out, since
-// the brute-force reference counts a polygon on a boundary in both regions it bounds.
-Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
-  std::uniform_real_distribution<double> xy(-100.0, 1700.0), z(-50.0, 500.0), small(-150.0, 150.0);
+// `count` triangles with corners in [xy0, xy1]^2 x [z0, z1], every second one big (corners
+// anywhere there) and the others small (within `small` of their first corner).
+struct SoupExtent {
+  double xy0, xy1, z0, z1, small;
+};
+Soup random_triangles(std::mt19937& rng, int count, const SoupExtent& e) {
+  std::uniform_real_distribution<double> xy(e.xy0, e.xy1), z(e.z0, e.z1), small(-e.small, e.small);
   Soup s;
   for (int k = 0; k < count; ++k) {
     const glm::dvec3 a(xy(rng), xy(rng), z(rng));
@@ -40,6 +43,14 @@ Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
       s.add(a, {xy(rng), xy(rng), z(rng)}, {xy(rng), xy(rng), z(rng)});
     }
   }
+  return s;
+}
+
+// Over the 16-cell test window. With `in_planes`, two more lie exactly in split planes; the
+// area tests leave them out, since the brute-force reference counts a polygon on a boundary in
+// both regions it bounds.
+Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
+  Soup s = random_triangles(rng, count, {-100.0, 1700.0, -50.0, 500.0, 150.0});
   if (in_planes) {
     s.add({800.0, 100.0, 0.0}, {800.0, 900.0, 50.0}, {800.0, 500.0, 450.0});   // in the root plane
     s.add({300.0, 400.0, 20.0}, {1200.0, 400.0, 30.0}, {700.0, 400.0, 380.0});  // in a y plane
@@ -165,6 +176,87 @@ TEST(Merge, SlidingMergesThePolygonsAgainIntoTheMovedWindow) {
   tree.traverse(c, o, f);
   EXPECT_NEAR(drawn_merged_area(tree, f), test::area_above_drawn_terrain(tree, f, soup, 400.0, 2000.0, 0.0, 1600.0),
               1e-6 * soup.area);
+}
+
+// Triangles over the 64 x 64-sample terrain of SlidingTerrain (6.3 km): big and small ones,
+// through its volume.
+Soup soup_over_sliding_terrain(std::mt19937& rng, int count) {
+  return random_triangles(rng, count, {-150.0, 3000.0, -50.0, 450.0, 200.0});
+}
+
+// A slide by whole level-0 cells over the same terrain keeps the slots and pieces of the cells
+// in both windows and merges only what lies beyond them (section 4.3): after each slide of a
+// walk, fewer slots are built than a merge of everything builds, and from random eyes the
+// frames draw the terrain of a tree built there anew, the merged area that tree draws and the
+// brute-force reference finds, in back-to-front order.
+TEST(Merge, ASlideByWholeCellsKeepsWhatStaysAndDrawsWhatAFreshMergeDraws) {
+  std::mt19937 rng(1997);
+  const test::SlidingTerrain terrain(5);
+  const Soup soup = soup_over_sliding_terrain(rng, 60);
+  TerrainTree slid(terrain.window_at(0, 0).view(), 3);  // level 0: 4 x 4 cells of 4 x 4 samples
+  slid.merge(soup.v, soup.c, soup.t);
+  const int walk[][2] = {{8, 4}, {4, 16}, {16, 16}, {8, 8}, {12, 4}, {12, 12}, {12, 12}};
+  for (const auto& at : walk) {
+    const TestWindow w = terrain.window_at(at[0], at[1]);
+    slid.slide(w.view());
+    const MergeStats& moved = slid.merge_stats();
+    TerrainTree fresh(w.view(), 3);
+    const MergeStats all = fresh.merge(soup.v, soup.c, soup.t);
+    EXPECT_LT(moved.rebuilt_slots, all.rebuilt_slots) << "at " << at[0] << ", " << at[1];
+    EXPECT_EQ(slid.positions().size() - slid.merged_base(), slid.merged_colors().size());
+    const double x0 = 100.0 * at[0], y0 = 100.0 * at[1];
+    std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(0.0, 700.0), dir(-1.0, 1.0);
+    Frame fs, ff;
+    for (int trial = 0; trial < 8; ++trial) {
+      const glm::dvec3 eye(x0 + xy(rng), y0 + xy(rng), 350.0 + z(rng));
+      const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.7});
+      TraversalOptions o;
+      o.cull = false;
+      o.threshold_px = 1.0f + static_cast<float>(trial);
+      slid.traverse(c, o, fs);
+      fresh.traverse(c, o, ff);
+      std::vector<std::uint32_t> terrain_s, terrain_f;
+      for (std::size_t t = 0; t < fs.level.size(); ++t)
+        if (fs.level[t] != kMergedLevel) terrain_s.insert(terrain_s.end(), fs.indices.begin() + 3 * t, fs.indices.begin() + 3 * t + 3);
+      for (std::size_t t = 0; t < ff.level.size(); ++t)
+        if (ff.level[t] != kMergedLevel) terrain_f.insert(terrain_f.end(), ff.indices.begin() + 3 * t, ff.indices.begin() + 3 * t + 3);
+      EXPECT_EQ(terrain_s, terrain_f);
+      const double expected = test::area_above_drawn_terrain(slid, fs, soup, x0, x0 + 1600.0, y0, y0 + 1600.0);
+      EXPECT_NEAR(drawn_merged_area(slid, fs), expected, 1e-6 * soup.area) << "trial " << trial;
+      EXPECT_NEAR(drawn_merged_area(slid, fs), drawn_merged_area(fresh, ff), 1e-6 * soup.area) << "trial " << trial;
+      EXPECT_EQ(order_violations(slid, fs, eye, 150, rng, true), 0) << "trial " << trial;
+    }
+  }
+}
+
+// Sliding there and back again keeps no more than a tree built at the end holds: the pieces
+// and vertices of what left the window are dropped.
+TEST(Merge, SlidingThereAndBackAgainHoldsWhatAFreshTreeHolds) {
+  std::mt19937 rng(31);
+  const test::SlidingTerrain terrain(6);
+  const Soup soup = soup_over_sliding_terrain(rng, 40);
+  TerrainTree slid(terrain.window_at(0, 0).view(), 3);
+  slid.merge(soup.v, soup.c, soup.t);
+  for (int k = 0; k < 12; ++k) slid.slide(terrain.window_at(k % 2 ? 0 : 8, k % 2 ? 0 : 4).view());
+  TerrainTree fresh(terrain.window_at(0, 0).view(), 3);
+  fresh.merge(soup.v, soup.c, soup.t);
+  EXPECT_LT(slid.memory().merged, 2 * fresh.memory().merged);
+  EXPECT_LT(slid.merge_stats().stored_polygons, 2 * fresh.merge_stats().stored_polygons);
+}
+
+// A window over other heights, or not moved by whole level-0 cells, is merged anew.
+TEST(Merge, AWindowOverOtherTerrainIsMergedAnew) {
+  std::mt19937 rng(8);
+  const test::SlidingTerrain a(1), b(2);
+  const Soup soup = soup_over_sliding_terrain(rng, 20);
+  TerrainTree tree(a.window_at(0, 0).view(), 3);
+  const MergeStats all = tree.merge(soup.v, soup.c, soup.t);
+  tree.slide(b.window_at(4, 4).view());  // other heights where they overlap
+  const std::size_t slots = tree.merge_stats().slots;
+  EXPECT_EQ(tree.merge_stats().rebuilt_slots, slots);
+  tree.slide(b.window_at(6, 4).view());  // two columns: not a whole level-0 cell
+  EXPECT_EQ(tree.merge_stats().rebuilt_slots, tree.merge_stats().slots);
+  EXPECT_GT(all.slots, 0u);
 }
 
 // A surface entirely above a cell's terrain stays whole at that cell: a flat sheet of 8

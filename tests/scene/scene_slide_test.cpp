@@ -65,11 +65,20 @@ TEST(TerrainSceneSlide, KeepsTheFrameAndMatchesAFreshWindowThere) {
   EXPECT_DOUBLE_EQ(scene.bounds().west, fresh.bounds().west);
   ASSERT_EQ(scene.heights().size(), fresh.heights().size());
   for (std::size_t k = 0; k < scene.heights().size(); ++k) ASSERT_EQ(scene.heights()[k], fresh.heights()[k]) << k;
-  // The lattice lies where the old frame puts the moved window's meridians and parallels.
+  // The lattice lies where the old frame puts the moved window's meridians and parallels, and
+  // a sample the two windows share has the same plane offsets in both, to the bit (what lets
+  // the tree keep what lies on them).
   const io::Georef& g = mosaic.georef();
   for (int i : {0, 100, 256}) {
-    EXPECT_DOUBLE_EQ(scene.xs()[i], scene.frame().x_of_lon(scene.bounds().west + i * g.dx));
-    EXPECT_DOUBLE_EQ(scene.ys()[i], scene.frame().y_of_lat(scene.bounds().south + i * g.dy));
+    EXPECT_NEAR(scene.xs()[i], scene.frame().x_of_lon(scene.bounds().west + i * g.dx), 1e-6);
+    EXPECT_NEAR(scene.ys()[i], scene.frame().y_of_lat(scene.bounds().south + i * g.dy), 1e-6);
+  }
+  const TerrainScene before(mosaic, kWindow, 4);
+  for (int i : {0, 100, 224}) {  // column i + 32 before the move is column i after it
+    EXPECT_EQ(scene.xs()[i], before.xs()[i + 32]);
+  }
+  for (int j : {64, 100, 256}) {  // rows count from the south: 64 rows north
+    EXPECT_EQ(scene.ys()[j - 64], before.ys()[j]);
   }
   // The tree's lattice vertices follow.
   const auto& p = scene.tree().positions();
