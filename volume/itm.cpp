@@ -7,7 +7,7 @@
 // version 1.2.2, so where it is terse the behaviour of that version is meant; NTIA's published
 // point-to-point cases (tests/volume/data/ntia_itm_p2p.txt) check the whole chain.
 //
-// The chain, per path (ItmPath::loss):
+// The chain, per path (ItmPath::loss, ItmPath::losses):
 //  1. General preparation (the Algorithm, "preparatory calculations"): wave number
 //     k = f / 47.7 MHz m; surface refractivity N_s = N_0 exp(-z_s / 9460 m) with z_s the mean
 //     elevation of the middle 80% of the profile; effective Earth curvature
@@ -38,16 +38,21 @@
 //  Basic transmission loss = 32.45 + 20 log10(f / MHz) + 20 log10(d / km) + A.
 //
 // Where this departs from a plain transcription, it is for speed and gives the same values (to
-// rounding): the transmitter's steepest interior sample is found once per profile, the
-// receiver's from an upper envelope of its horizon lines built once per profile; least-squares
-// lines over the profile come from prefix sums; Delta h is kept while its window does not
-// change, and its quantiles are searched first among the values near the last ones found;
-// troposcatter is evaluated only for paths long enough that it could matter (beyond
-// max(d_Ls, d_L + 0.3 X_ae ln(47.7 k)), the least the crossover distance can be). One change
-// of substance, at rounding level: positions and counts within 1e-9 of a whole number are taken
-// as that number before the Algorithm rounds them (snap()), so that a path and its reverse
-// give the same loss; otherwise a window end at 0.9 of a horizon distance of ten samples falls
-// on either side of a sample depending on the direction of computation.
+// rounding; tests/volume/itm_reference.h is the plain transcription the tests hold it to): the
+// transmitter's steepest interior sample is found once per profile, the receiver's from an
+// upper envelope of its horizon lines built once per profile; least-squares lines over the
+// profile come from prefix sums; Delta h is kept while its window does not change, and its
+// quantiles are searched first among the values near the last ones found. The rest of the
+// chain, from the effective heights on (the end of step 2, steps 3 and 4), runs four heights
+// at a time (volume/itm_kernel.h, compiled twice: for the baseline instruction set and for
+// AVX2), each branch of the Algorithm a choice between lanes, with the exponential,
+// logarithm, cube root, sine and cosine written out in plain arithmetic to about one unit in
+// the last place; troposcatter is evaluated only for paths long enough that it could matter
+// (beyond max(d_Ls, d_L + 0.3 X_ae ln(47.7 k)), the least the crossover distance can be). One
+// change of substance, at rounding level: positions and counts within 1e-9 of a whole number
+// are taken as that number before the Algorithm rounds them (snap()), so that a path and its
+// reverse give the same loss; otherwise a window end at 0.9 of a horizon distance of ten
+// samples falls on either side of a sample depending on the direction of computation.
 //
 // Limits: the model's own (20 MHz - 20 GHz; paths of 1 - 2000 km; antennas 0.5 - 3000 m; it
 // reports "warning" 3 or 4 outside them, and still gives a number); a single profile stands
@@ -55,7 +60,11 @@
 // statistics are those of the Algorithm's climate curves, fitted to measurements of the 1960s.
 #include "volume/itm.h"
 
+#define TERRAVOL_ITM_KERNEL baseline
+#include "volume/itm_kernel.h"
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <complex>
 #include <cstdint>
@@ -132,54 +141,22 @@ constexpr Climate kClimates[7] = {
      {8.43, 8.19, 136.2e3, 188.5e3, 122.9e3}, 1.518, 1.282, {1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}},
 };
 
-using itm_detail::TerminalTerms;
+namespace kernel = itm_kernel::baseline;
 
-// What the preparatory stage hands to the reference attenuation: the path length, the
-// antennas' structural and effective heights, the horizon distances and elevation angles, and
-// the terrain irregularity. Index 0 is the transmitter.
-struct Geometry {
-  double dist = 0.0;
-  double hg[2] = {0, 0}, he[2] = {0, 0}, dl[2] = {0, 0}, the[2] = {0, 0};
-  double dh = 0.0;
-  TerminalTerms terms[2];
-};
+std::atomic<bool> baseline_forced{false};
 
-struct Medium {
-  double wn = 0.0, ens = 0.0, gme = 0.0;
-  Complex zg;
-  double inverse_abs_zg = 0.0;  // 1 / |Z_g|
-  double xae = 0.0;             // (k gamma_e^2)^(-1/3)
-};
+// The kernel of this processor: AVX2 where it has it (and the operating system saves its
+// registers), else the baseline one; the same values either way.
+bool use_avx2() { return __builtin_cpu_supports("avx2") && !baseline_forced.load(std::memory_order_relaxed); }
 
-// What the statistics take from the frequency and the climate alone.
-struct Statistics {
-  const Climate* climate = nullptr;
-  double g_minus = 0.0, g_plus = 0.0;  // the frequency factors
-  double dexa_frequency_m = 0.0;       // the frequency's part of d_e's scale, (575.7e12 / k)^(1/3)
-};
-
-// The cube root of x > 0, to the last bit or two (relative error under 1e-15): an estimate
-// from the exponent bits refined by two Halley steps and one Newton step. Written here
-// because the C library's cbrt was the model's most expensive function (four per point).
-double cube_root(double x) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &x, sizeof bits);
-  bits = bits / 3 + 0x2A9F7893782DA1CEull;
-  double y = 0.0;
-  std::memcpy(&y, &bits, sizeof y);
-  for (int k = 0; k < 2; ++k) {
-    const double y3 = y * y * y;
-    y = y * (y3 + 2.0 * x) / (2.0 * y3 + x);
+void evaluate(const itm_kernel::Path& path, itm_kernel::Lanes& lanes) {
+  if (use_avx2()) {
+    itm_kernel::avx2::evaluate(path, lanes);
+  } else {
+    kernel::evaluate(path, lanes);
   }
-  return y - (y * y * y - x) / (3.0 * y * y);
 }
 
-// Delta h(d) = (1 - 0.8 exp(-d / 50 km)) Delta h: the irregularity seen over a distance d.
-double delta_h_over(double d, double dh) { return (1.0 - 0.8 * std::exp(-d / 50e3)) * dh; }
-
-// sigma_h(Delta h) = 0.78 Delta h exp(-(Delta h / 16 m)^(1/4)): the rms deviation of the
-// terrain within the first Fresnel zones, from the irregularity.
-double sigma_h(double dh) { return 0.78 * dh * std::exp(-std::sqrt(std::sqrt(dh / 16.0))); }
 
 // A line fitted by least squares, with the trapezoidal rule's weights (half at both ends), to
 // samples ja..jb (unit spacing) given their sums: the Algorithm's fit of a line to a profile.
@@ -204,7 +181,11 @@ Line trapezoid_fit(double sum_z, double sum_iz, double z_first, double z_last, i
 // end at 0.9 or 0.1 of a horizon distance that is a multiple of ten samples): which way they
 // go must not depend on the direction the path was computed in.
 double snap(double x) {
-  const double r = std::round(x);
+  // The nearest whole number by adding and taking off 1.5 * 2^52 (the baseline instruction set
+  // has no rounding instruction, and std::round is a call); only |x| < 2^51 gets near one.
+  constexpr double kShift = 6755399441055744.0;
+  if (!(std::abs(x) < 2251799813685248.0)) return x;
+  const double r = (x + kShift) - kShift;
   return std::abs(x - r) < 1e-9 * std::max(1.0, std::abs(x)) ? r : x;
 }
 double in_samples(double x, double xi) { return snap(x / xi); }
@@ -261,116 +242,69 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   const int ka = std::clamp(static_cast<int>(snap(0.1 * (span + 8.0))), 4, 25);
   const int n = 10 * ka - 5;
   const auto size = static_cast<std::size_t>(n);
-  w.samples.resize(size);
-  w.low.resize(size);
-  w.high.resize(size);
+  constexpr auto kParts = static_cast<std::size_t>(itm_kernel::kSumParts);
+  w.samples.resize((size + kParts - 1) / kParts * kParts);
+  w.low.resize(size + kParts);
+  w.high.resize(size + kParts);
+  w.spare.resize(size + kParts);
   double* s = w.samples.data();
   // Linear interpolation at n equally spaced points p from xa to xb, each on the interval that
-  // ends at sample k = ceil(p), within [floor(xa) + 1, np] (p >= 0 here, so ceil(p) is the
-  // truncation plus one unless p is whole); the sums for the line, in order.
+  // ends at sample k = ceil(p), within [floor(xa) + 1, np]; the sums for the line.
   const double step = (xb - xa) / (n - 1);
   const int k0 = std::clamp(static_cast<int>(std::floor(xa)) + 1, 1, np);
-  double sum = 0.0, sum_i = 0.0, jd = 0.0;
-  int j = 0;
-#if defined(__SSE2__)
-  // Two points at a time, with the same operations as the scalar loop below.
-  {
-    const __m128d xa2 = _mm_set1_pd(xa), step2 = _mm_set1_pd(step), one = _mm_set1_pd(1.0);
-    const __m128d two = _mm_set1_pd(2.0), lo = _mm_set1_pd(k0), hi = _mm_set1_pd(np);
-    __m128d j2 = _mm_set_pd(1.0, 0.0);
-    for (; j + 1 < n; j += 2, j2 = _mm_add_pd(j2, two)) {
-      const __m128d p = _mm_add_pd(xa2, _mm_mul_pd(j2, step2));
-      __m128d k = _mm_cvtepi32_pd(_mm_cvttpd_epi32(p));
-      k = _mm_add_pd(k, _mm_and_pd(_mm_cmplt_pd(k, p), one));
-      k = _mm_min_pd(hi, _mm_max_pd(lo, k));
-      const __m128i ki = _mm_cvttpd_epi32(k);
-      const int ka0 = _mm_cvtsi128_si32(ki), ka1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(ki, 1));
-      const __m128d zk = _mm_loadh_pd(_mm_load_sd(z + ka0), z + ka1);
-      const __m128d zm = _mm_loadh_pd(_mm_load_sd(z + ka0 - 1), z + ka1 - 1);
-      const __m128d v = _mm_add_pd(zk, _mm_mul_pd(_mm_sub_pd(zk, zm), _mm_sub_pd(p, k)));
-      _mm_storeu_pd(s + j, v);
-      const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
-      sum += v0;
-      sum_i += jd * v0;
-      jd += 1.0;
-      sum += v1;
-      sum_i += jd * v1;
-      jd += 1.0;
-    }
-  }
-#endif
-  for (; j < n; ++j, jd += 1.0) {
-    const double p = xa + j * step;
-    int k = static_cast<int>(p);
-    k += k < p ? 1 : 0;
-    k = std::min(np, std::max(k0, k));
-    const double v = z[k] + (z[k] - z[k - 1]) * (p - k);
-    s[j] = v;
-    sum += v;
-    sum_i += jd * v;
-  }
+  const bool avx2 = use_avx2();
+  const itm_kernel::Sums sums = avx2 ? itm_kernel::avx2::resample(z, np, k0, xa, step, n, s)
+                                     : kernel::resample(z, np, k0, xa, step, n, s);
+  const double sum = sums.sum, sum_i = sums.sum_i;
   const Line line = trapezoid_fit(sum, sum_i, s[0], s[n - 1], 0, n - 1);
   const double at0 = line.at(0.0), slope = line.slope;
   // The ka-th smallest and the ka-th largest deviation from the line. Their candidates are
-  // gathered in the same pass: the deviations beyond thresholds a little inside the last ones
-  // found; when too few, again with thresholds 4, 16 and 64 times farther in, then all. Exact
-  // whatever the guess: it only decides how much is gathered. Deviation i is
-  // s[i] - (at0 + slope i), computed alike wherever it is needed.
+  // gathered in one pass: the deviations beyond thresholds a margin inside the last ones
+  // found, each side's margin (a fraction of their distance) grown after a miss and shrunk
+  // after a haul much larger than needed; a side with too few gathers again with its margin 4,
+  // 16 and 64 times wider, then all. Exact whatever the guess: it only decides how much is
+  // gathered. Deviation i is s[i] - (at0 + slope i), computed alike wherever it is needed.
   const auto rank = static_cast<std::size_t>(ka - 1);
   const bool guessed = std::isfinite(w.lower) && std::isfinite(w.upper) && w.upper > w.lower;
-  const double margin = guessed ? 0.02 * (w.upper - w.lower) : 0.0;
+  const double range = guessed ? w.upper - w.lower : 0.0;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double* low = w.low.data();
   double* high = w.high.data();
+  double* spare = w.spare.data();  // where a side that has enough gathers nothing
+  auto beyond = [&](bool redo_low, double low_threshold, bool redo_high, double high_threshold) {
+    const double lt = redo_low ? low_threshold : -kInf, ht = redo_high ? high_threshold : kInf;
+    double* l = redo_low ? low : spare;
+    double* h = redo_high ? high : spare;
+    return avx2 ? itm_kernel::avx2::beyond(s, n, at0, slope, lt, ht, l, h) : kernel::beyond(s, n, at0, slope, lt, ht, l, h);
+  };
   std::size_t n_low = 0, n_high = 0;
   if (guessed) {
-    const double low_threshold = w.lower + margin, high_threshold = w.upper - margin;
-    int i = 0;
-#if defined(__SSE2__)
-    {
-      const __m128d at2 = _mm_set1_pd(at0), slope2 = _mm_set1_pd(slope), two = _mm_set1_pd(2.0);
-      const __m128d lt = _mm_set1_pd(low_threshold), ht = _mm_set1_pd(high_threshold);
-      __m128d i2 = _mm_set_pd(1.0, 0.0);
-      for (; i + 1 < n; i += 2, i2 = _mm_add_pd(i2, two)) {
-        const __m128d r = _mm_sub_pd(_mm_loadu_pd(s + i), _mm_add_pd(at2, _mm_mul_pd(slope2, i2)));
-        const int below = _mm_movemask_pd(_mm_cmple_pd(r, lt)), above = _mm_movemask_pd(_mm_cmpge_pd(r, ht));
-        const double r0 = _mm_cvtsd_f64(r), r1 = _mm_cvtsd_f64(_mm_unpackhi_pd(r, r));
-        low[n_low] = r0;
-        n_low += static_cast<std::size_t>(below & 1);
-        low[n_low] = r1;
-        n_low += static_cast<std::size_t>(below >> 1);
-        high[n_high] = r0;
-        n_high += static_cast<std::size_t>(above & 1);
-        high[n_high] = r1;
-        n_high += static_cast<std::size_t>(above >> 1);
+    const itm_kernel::Counts c = beyond(true, w.lower + w.low_margin * range, true, w.upper - w.high_margin * range);
+    n_low = c.low;
+    n_high = c.high;
+    auto adapt = [&](double& margin, std::size_t count) {
+      if (count <= rank) {
+        margin = std::min(2.0 * margin, 0.5);
+      } else if (count > rank + 6) {
+        margin = std::max(0.75 * margin, 0.002);
       }
-    }
-#endif
-    for (double id = i; i < n; ++i, id += 1.0) {
-      const double r = s[i] - (at0 + slope * id);
-      low[n_low] = r;
-      n_low += r <= low_threshold ? 1 : 0;
-      high[n_high] = r;
-      n_high += r >= high_threshold ? 1 : 0;
+    };
+    adapt(w.low_margin, n_low);
+    adapt(w.high_margin, n_high);
+    for (double widen = 4.0; widen <= 64.0 && (n_low <= rank || n_high <= rank); widen *= 4.0) {
+      const bool redo_low = n_low <= rank, redo_high = n_high <= rank;
+      const itm_kernel::Counts again =
+          beyond(redo_low, w.lower + widen * w.low_margin * range, redo_high, w.upper - widen * w.high_margin * range);
+      if (redo_low) n_low = again.low;
+      if (redo_high) n_high = again.high;
     }
   }
-  // One side again, below threshold (sign 1) or above it (sign -1); everything when not finite.
-  auto regather = [&](double* c, double sign, double threshold) {
-    std::size_t count = 0;
-    double id = 0.0;
-    for (int i = 0; i < n; ++i, id += 1.0) {
-      const double r = s[i] - (at0 + slope * id);
-      c[count] = r;
-      count += sign * r <= sign * threshold ? 1 : 0;
-    }
-    return count;
-  };
-  for (double widen = 4.0; widen <= 64.0 && guessed; widen *= 4.0) {
-    if (n_low <= rank) n_low = regather(low, 1.0, w.lower + widen * margin);
-    if (n_high <= rank) n_high = regather(high, -1.0, w.upper - widen * margin);
+  if (n_low <= rank || n_high <= rank) {
+    const bool redo_low = n_low <= rank, redo_high = n_high <= rank;
+    const itm_kernel::Counts all = beyond(redo_low, kInf, redo_high, -kInf);
+    if (redo_low) n_low = all.low;
+    if (redo_high) n_high = all.high;
   }
-  if (n_low <= rank) n_low = regather(low, 1.0, kInf);
-  if (n_high <= rank) n_high = regather(high, -1.0, -kInf);
   const double lower = kth_extreme<false>(low, n_low, rank);
   const double upper = kth_extreme<true>(high, n_high, rank);
   w.lower = lower;
@@ -378,302 +312,24 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
-TerminalTerms terminal_terms(double dl, double he, const Medium& m) {
-  TerminalTerms t;
-  t.dls = std::sqrt(2.0 * he / m.gme);
-  const double a = 0.5 * dl * dl / he;  // the horizon's radius
-  const double wa = cube_root(a * m.wn);
-  const double pk = m.inverse_abs_zg / wa;
-  t.x = (1.607 - pk) * 151.0 * wa * dl / a;
-  t.gain_db = itm_functions::height_gain_db(t.x, pk);
-  t.dexa = std::sqrt(18e6 * he);
-  return t;
-}
-
-// The diffraction attenuation A_diff(d) (4.11) for one geometry: with the weight w, the
-// rounded-Earth (three radii) value A_r and the double knife edge A_k, w A_r + (1 - w) A_k + A_fo.
-class Diffraction {
- public:
-  Diffraction(const Geometry& g, const Medium& m, double dlsa, double dla, double tha)
-      : g_(g), wn_(m.wn), gme_(m.gme), dla_(dla), tha_(tha) {
-    const double hgg = g.hg[0] * g.hg[1];
-    // The point-to-point mode adds 10 m^2 to the product of the structural heights.
-    wd1_ = std::sqrt(1.0 + (g.he[0] * g.he[1] - hgg) / (hgg + 10.0));
-    xd1_ = dla + tha / m.gme;
-    afo_ = std::min(15.0, 2.171 * std::log(1.0 + 4.77e-4 * hgg * m.wn * sigma_h(delta_h_over(dlsa, g.dh))));
-    qk_ = m.inverse_abs_zg;
-    for (const TerminalTerms& t : g.terms) {
-      xht_ += t.x;
-      aht_ += t.gain_db;
-    }
-  }
-
-  double at(double d) const {
-    const double th = tha_ + d * gme_;
-    const double ds = d - dla_;
-    const double v2 = 0.0795775 * wn_ * ds * th * th;  // 1 / (4 pi)
-    const double knife = itm_functions::knife_edge_db(v2 * g_.dl[0] / (ds + g_.dl[0])) +
-                         itm_functions::knife_edge_db(v2 * g_.dl[1] / (ds + g_.dl[1]));
-    const double a = ds / th;
-    const double wa = cube_root(a * wn_);
-    const double pk = qk_ / wa;
-    const double x = (1.607 - pk) * 151.0 * wa * th + xht_;
-    const double rounded = 0.05751 * x - 4.343 * std::log(x) - aht_;
-    const double q = (wd1_ + xd1_ / d) * std::min(delta_h_over(d, g_.dh) * wn_, 6283.2);
-    const double w = 25.1 / (25.1 + std::sqrt(q));
-    return rounded * w + (1.0 - w) * knife + afo_;
-  }
-
- private:
-  const Geometry& g_;
-  double wn_, gme_, dla_, tha_;
-  double wd1_ = 0.0, xd1_ = 0.0, afo_ = 0.0, qk_ = 0.0, aht_ = 20.0, xht_ = 0.0;
-};
-
-// The line-of-sight attenuation A_los(d) (4.44): the two-ray field over rough ground, with the
-// reflection coefficient reduced by the terrain's roughness, mixed with the extended
-// diffraction line A_ed + m_d d by the weight w.
-class LineOfSight {
- public:
-  LineOfSight(const Geometry& g, const Medium& m, double emd, double aed, double dlsa)
-      : g_(g), m_(m), emd_(emd), aed_(aed), wls_(0.021 / (0.021 + m.wn * g.dh / std::max(10e3, dlsa))) {}
-
-  double at(double d) const {
-    const double sh = sigma_h(delta_h_over(d, g_.dh));
-    const double hsum = g_.he[0] + g_.he[1];
-    const double sin_psi = hsum / std::sqrt(d * d + hsum * hsum);
-    // R = (sin psi - Z_g) / (sin psi + Z_g) exp(-min(10, k sigma_h sin psi)), in real arithmetic.
-    const double zr = m_.zg.real(), zi = m_.zg.imag();
-    const double nr = sin_psi - zr, dr = sin_psi + zr;  // numerator -i zi, denominator +i zi
-    const double scale = std::exp(-std::min(10.0, m_.wn * sh * sin_psi)) / (dr * dr + zi * zi);
-    double rr = (nr * dr - zi * zi) * scale, ri = (-zi * dr - nr * zi) * scale;
-    const double r2 = rr * rr + ri * ri;
-    if (r2 < 0.25 || r2 < sin_psi) {
-      const double f = std::sqrt(sin_psi / r2);
-      rr *= f;
-      ri *= f;
-    }
-    const double extended = emd_ * d + aed_;
-    double delta = 2.0 * m_.wn * g_.he[0] * g_.he[1] / d;  // the rays' phase difference
-    if (delta > 1.57) delta = 3.14 - 2.4649 / delta;
-    const double sum_r = std::cos(delta) + rr, sum_i = -std::sin(delta) + ri;
-    const double two_ray = -4.343 * std::log(sum_r * sum_r + sum_i * sum_i);
-    return (two_ray - extended) * wls_ + extended;
-  }
-
- private:
-  const Geometry& g_;
-  const Medium& m_;
-  double emd_, aed_, wls_;
-};
-
-// The troposcatter attenuation A_scat(d). Its frequency gain H_0 carries from one evaluation to
-// the next (the Algorithm keeps the previous value when the new one would exceed 15 dB), so
-// the order of evaluation is the Algorithm's: the farther distance first.
-class Troposcatter {
- public:
-  Troposcatter(const Geometry& g, const Medium& m, double tha) : g_(g), m_(m), tha_(tha) {
-    ad_ = g.dl[0] - g.dl[1];
-    rr_ = g.he[1] / g.he[0];
-    if (ad_ < 0.0) {
-      ad_ = -ad_;
-      rr_ = 1.0 / rr_;
-    }
-    etq_ = (5.67e-6 * m.ens - 2.32e-3) * m.ens + 0.031;
-  }
-
-  // 1001 dB (no scatter) when both antennas are too low for it.
-  double at(double d) {
-    double h0 = h0s_;
-    if (h0s_ <= 15.0) {
-      const double th = g_.the[0] + g_.the[1] + d * m_.gme;
-      const double r1 = 2.0 * m_.wn * th * g_.he[0], r2 = 2.0 * m_.wn * th * g_.he[1];
-      if (r1 < 0.2 && r2 < 0.2) return 1001.0;
-      double ss = (d - ad_) / (d + ad_);
-      const double q = std::min(std::max(0.1, rr_ / ss), 10.0);
-      ss = std::max(0.1, ss);
-      const double z0 = (d - ad_) * (d + ad_) * th * 0.25 / d;  // height of the crossing rays
-      const double et = (etq_ * std::exp(-std::pow(std::min(1.7, z0 / 8.0e3), 6.0)) + 1.0) * z0 / 1.7556e3;
-      const double ett = std::max(et, 1.0);
-      h0 = 0.5 * (itm_functions::frequency_gain_db(r1, ett) + itm_functions::frequency_gain_db(r2, ett));
-      h0 += std::min(h0, (1.38 - std::log(ett)) * std::log(ss) * std::log(q) * 0.49);
-      h0 = std::max(h0, 0.0);
-      if (et < 1.0) {
-        const double f = (1.0 + 1.4142 / r1) * (1.0 + 1.4142 / r2);
-        h0 = et * h0 + (1.0 - et) * 4.343 * std::log(f * f * (r1 + r2) / (r1 + r2 + 2.8284));
-      }
-      if (h0 > 15.0 && h0s_ >= 0.0) h0 = h0s_;
-    }
-    h0s_ = h0;
-    const double th = tha_ + d * m_.gme;
-    return itm_functions::scatter_f_db(th * d) + 4.343 * std::log(47.7 * m_.wn * th * th * th * th) -
-           0.1 * (m_.ens - 301.0) * std::exp(-th * d / 40e3) + h0;
-  }
-
- private:
-  const Geometry& g_;
-  const Medium& m_;
-  double tha_, ad_ = 0.0, rr_ = 0.0, etq_ = 0.0, h0s_ = -15.0;
-};
-
-struct Reference {
-  double aref = 0.0;
-  ItmMode mode = ItmMode::kLineOfSight;
-  int warning = 0;
-};
-
-// The reference attenuation of the Algorithm's point-to-point mode at the path's own length.
-Reference reference_attenuation(const Geometry& g, const Medium& m) {
-  Reference out;
-  int& w = out.warning;
-  const double dls[2] = {g.terms[0].dls, g.terms[1].dls};  // smooth-Earth horizons
-  const double dlsa = dls[0] + dls[1], dla = g.dl[0] + g.dl[1];
-  const double tha = std::max(g.the[0] + g.the[1], -dla * m.gme);
-
-  // The Algorithm's range checks.
-  if (m.wn < 0.838 || m.wn > 210.0) w = std::max(w, 1);
-  for (int j = 0; j < 2; ++j) {
-    if (g.hg[j] < 1.0 || g.hg[j] > 1000.0) w = std::max(w, 1);
-    if (std::abs(g.the[j]) > 200e-3 || g.dl[j] < 0.1 * dls[j] || g.dl[j] > 3.0 * dls[j]) w = std::max(w, 3);
-  }
-  if (m.ens < 250.0 || m.ens > 400.0 || m.gme < 75e-9 || m.gme > 250e-9 || m.zg.real() <= std::abs(m.zg.imag()) ||
-      m.wn < 0.419 || m.wn > 420.0 || g.hg[0] < 0.5 || g.hg[0] > 3000.0 || g.hg[1] < 0.5 || g.hg[1] > 3000.0) {
-    w = 4;
-  }
-  if (g.dist > 1000e3) w = std::max(w, 1);
-  if (g.dist < std::abs(g.he[0] - g.he[1]) / 200e-3) w = std::max(w, 3);
-  if (g.dist < 1e3 || g.dist > 2000e3) w = 4;
-
-  // The diffraction line through two distances beyond the smooth-Earth horizons.
-  const Diffraction diffraction(g, m, dlsa, dla, tha);
-  const double xae = m.xae;
-  const double d3 = std::max(dlsa, 1.3787 * xae + dla), d4 = d3 + 2.7574 * xae;
-  const double a3 = diffraction.at(d3), a4 = diffraction.at(d4);
-  const double emd = (a4 - a3) / (d4 - d3), aed = a3 - emd * d3;
-
-  const double d = g.dist;
-  if (d < dlsa) {
-    // Line of sight: A_el + k_1 d + k_2 ln d through A_los at d0 and d1 and the diffraction
-    // line at d2 = d_Ls, with k_1, k_2 >= 0.
-    const LineOfSight los(g, m, emd, aed, dlsa);
-    const double d2 = dlsa, a2 = aed + d2 * emd;
-    double d0 = 1.908 * m.wn * g.he[0] * g.he[1], d1;
-    if (aed >= 0.0) {
-      d0 = std::min(d0, 0.5 * dla);
-      d1 = d0 + 0.25 * (dla - d0);
-    } else {
-      d1 = std::max(-aed / emd, 0.25 * dla);
-    }
-    const double a1 = los.at(d1);
-    double ak1 = 0.0, ak2 = 0.0;
-    bool fitted = false;
-    const double ln_d2 = std::log(d2);
-    if (d0 < d1) {
-      const double a0 = los.at(d0);
-      const double ln_d0 = std::log(d0);
-      const double q = ln_d2 - ln_d0;  // ln(d2 / d0)
-      ak2 = std::max(0.0, ((d2 - d0) * (a1 - a0) - (d1 - d0) * (a2 - a0)) / ((d2 - d0) * (std::log(d1) - ln_d0) - (d1 - d0) * q));
-      fitted = aed >= 0.0 || ak2 > 0.0;
-      if (fitted) {
-        ak1 = (a2 - a0 - ak2 * q) / (d2 - d0);
-        if (ak1 < 0.0) {
-          ak1 = 0.0;
-          ak2 = std::max(a2 - a0, 0.0) / q;
-          if (ak2 == 0.0) ak1 = emd;
-        }
-      }
-    }
-    if (!fitted) {
-      ak1 = std::max(a2 - a1, 0.0) / (d2 - d1);
-      ak2 = 0.0;
-      if (ak1 == 0.0) ak1 = emd;
-    }
-    const double ael = a2 - ak1 * d2 - ak2 * ln_d2;
-    out.aref = ael + ak1 * d + (ak2 != 0.0 ? ak2 * std::log(d) : 0.0);
-    out.mode = ItmMode::kLineOfSight;
-  } else {
-    // Beyond: the diffraction line, or the troposcatter line beyond the distance d_x where it
-    // crosses below. d_x is at least dx_floor, so shorter paths need no scatter at all.
-    const double dx_floor = std::max(dlsa, dla + 0.3 * xae * std::log(47.7 * m.wn));
-    double dx = dx_floor, ems = emd, aes = aed;
-    if (d > dx_floor) {
-      Troposcatter scatter(g, m, tha);
-      const double d5 = dla + 200e3, d6 = d5 + 200e3;
-      const double a6 = scatter.at(d6);
-      const double a5 = scatter.at(d5);
-      if (a5 < 1000.0) {
-        ems = (a6 - a5) / 200e3;
-        dx = std::max(dx_floor, (a5 - aed - ems * d5) / (emd - ems));
-        aes = (emd - ems) * dx + aed;
-      } else {
-        dx = 10e6;
-      }
-    }
-    if (d > dx) {
-      out.aref = aes + ems * d;
-      out.mode = ItmMode::kTroposcatter;
-    } else {
-      out.aref = aed + emd * d;
-      out.mode = ItmMode::kDiffraction;
-    }
-  }
-  out.aref = std::max(out.aref, 0.0);
-  return out;
-}
-
-// The requested quantile of attenuation (the Algorithm, "statistics").
-double variability(double aref, const Geometry& g, const Medium& m, const Statistics& st, const ItmParameters& p,
-                   double zt, double zl, double zc, int& warning) {
-  const Climate& c = *st.climate;
-  const double gm = st.g_minus, gp = st.g_plus;
-  // The effective distance d_e: 130 km at the sum of the smooth-Earth horizons plus a
-  // frequency term, proportional before it and growing one for one after.
-  const double dexa = g.terms[0].dexa + g.terms[1].dexa + st.dexa_frequency_m;
-  const double de = g.dist < dexa ? 130e3 * g.dist / dexa : 130e3 + g.dist - dexa;
-  const double vmd = c.median(de);
-  const double sgtm = c.sigma_minus(de) * gm, sgtp = c.sigma_plus(de) * gp;
-  const double sgtd = sgtp * c.sd, tgtd = (sgtp - sgtd) * c.zd;
-  double sgl = 0.0;
-  if (p.location_variability) {
-    const double q = delta_h_over(g.dist, g.dh) * m.wn;
-    sgl = 10.0 * q / (q + 13.0);
-  }
-  double vs0 = 0.0;
-  if (p.situation_variability) {
-    const double a = 5.0 + 3.0 * std::exp(-de / 100e3);
-    vs0 = a * a;
-  }
-  switch (p.variability) {
-    case ItmVariability::kSingleMessage: zt = zl = zc; break;
-    case ItmVariability::kAccidental: zl = zc; break;
-    case ItmVariability::kMobile: zl = zt; break;
-    case ItmVariability::kBroadcast: break;
-  }
-  if (std::abs(zt) > 3.1 || std::abs(zl) > 3.1 || std::abs(zc) > 3.1) warning = std::max(warning, 1);
-  const double sgt = zt < 0.0 ? sgtm : zt <= c.zd ? sgtp : sgtd + tgtd / zt;
-  const double vs = vs0 + (sgt * zt) * (sgt * zt) / (7.8 + zc * zc) + (sgl * zl) * (sgl * zl) / (24.0 + zc * zc);
-  double yr = 0.0, sgc = 0.0;
-  switch (p.variability) {
-    case ItmVariability::kSingleMessage: sgc = std::sqrt(sgt * sgt + sgl * sgl + vs); break;
-    case ItmVariability::kAccidental:
-      yr = sgt * zt;
-      sgc = std::sqrt(sgl * sgl + vs);
-      break;
-    case ItmVariability::kMobile:
-      yr = std::sqrt(sgt * sgt + sgl * sgl) * zt;
-      sgc = std::sqrt(vs);
-      break;
-    case ItmVariability::kBroadcast:
-      yr = sgt * zt + sgl * zl;
-      sgc = std::sqrt(vs);
-      break;
-  }
-  double a = aref - vmd - yr - sgc * zc;
-  if (a < 0.0) a = a * (29.0 - a) / (29.0 - 10.0 * a);
-  return a;
-}
-
 }  // namespace
+
+namespace itm_detail {
+std::string kernel_name() { return use_avx2() ? "avx2" : "baseline"; }
+void force_baseline_kernel(bool force) { baseline_forced.store(force, std::memory_order_relaxed); }
+double kernel_exp(double x) { return kernel::vexp(kernel::splat(x))[0]; }
+double kernel_log(double x) { return kernel::vlog(kernel::splat(x))[0]; }
+double kernel_cbrt(double x) {
+  kernel::V ln_root;
+  return kernel::vcbrt(kernel::splat(x), ln_root)[0];
+}
+void kernel_sincos(double x, double& sine, double& cosine) {
+  kernel::V s, c;
+  kernel::vsincos(kernel::splat(x), s, c);
+  sine = s[0];
+  cosine = c[0];
+}
+}  // namespace itm_detail
 
 int ItmParameters::mdvar() const {
   return static_cast<int>(variability) + (location_variability ? 0 : 10) + (situation_variability ? 0 : 20);
@@ -756,11 +412,14 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   sum_z_.resize(size);
   sum_iz_.resize(size);
   sum_z_[0] = sum_iz_[0] = 0.0;
+  double sum = 0.0, sum_i = 0.0;  // running, so that no sum waits on a store and a load
   for (int i = 0; i <= n_; ++i) {
     const double z = z_[static_cast<std::size_t>(i)];
     if (!std::isfinite(z)) throw std::invalid_argument("ITM profile: sample " + std::to_string(i) + " is not finite");
-    sum_z_[static_cast<std::size_t>(i) + 1] = sum_z_[static_cast<std::size_t>(i)] + z;
-    sum_iz_[static_cast<std::size_t>(i) + 1] = sum_iz_[static_cast<std::size_t>(i)] + i * z;
+    sum += z;
+    sum_i += i * z;
+    sum_z_[static_cast<std::size_t>(i) + 1] = sum;
+    sum_iz_[static_cast<std::size_t>(i) + 1] = sum_i;
   }
   // N_s and gamma_e from the mean elevation of the middle 80% of the profile.
   const int p10 = static_cast<int>(0.1 * n_);
@@ -771,26 +430,37 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   gme_ = kGammaA * (1.0 - 0.04665 * std::exp(ns_ / 179.3));
 
   // Horizon terms: elevation angles on the Earth of curvature gamma_e (heights relative to the
-  // terminal, less the drop qc s^2 of the curved Earth, over the distance s).
+  // terminal, less the drop qc s^2 of the curved Earth, over the distance s). 1 / s from a
+  // table of 1 / i (kept between profiles), without a division per sample.
   const double qc = 0.5 * gme_;
   const double za = z_[0] + hg_tx_;
+  const auto samples = static_cast<std::size_t>(n_) + 1;
+  for (std::size_t i = std::max<std::size_t>(inverse_.size(), 1); i < samples; ++i) {
+    if (inverse_.empty()) inverse_.push_back(0.0);
+    inverse_.push_back(1.0 / static_cast<double>(i));
+  }
+  rx_a_.resize(samples);
+  rx_u_.resize(samples);
+  tx_angle_.resize(samples);
+  const double inverse_xi = 1.0 / xi_;
+  for (int i = 1; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double z = z_[k];
+    const double s = i * xi_, sb = dist_ - s;
+    const double inverse_sb = inverse_xi * inverse_[static_cast<std::size_t>(n_ - i)];
+    tx_angle_[k] = (z - za) * (inverse_xi * inverse_[k]) - qc * s;
+    rx_a_[k] = z * inverse_sb - qc * sb;
+    rx_u_[k] = inverse_sb;
+  }
   tx_best_angle_ = -std::numeric_limits<double>::infinity();
   tx_best_distance_ = dist_;
-  rx_a_.resize(static_cast<std::size_t>(n_) + 1);
-  rx_u_.resize(static_cast<std::size_t>(n_) + 1);
   for (int i = 1; i < n_; ++i) {
-    const double z = z_[static_cast<std::size_t>(i)];
-    const double s = i * xi_, sb = dist_ - s;
-    const double angle = (z - za) / s - qc * s;
-    if (angle > tx_best_angle_) {
-      tx_best_angle_ = angle;
-      tx_best_distance_ = s;
+    if (tx_angle_[static_cast<std::size_t>(i)] > tx_best_angle_) {
+      tx_best_angle_ = tx_angle_[static_cast<std::size_t>(i)];
+      tx_best_distance_ = i * xi_;
     }
-    rx_a_[static_cast<std::size_t>(i)] = z / sb - qc * sb;
-    rx_u_[static_cast<std::size_t>(i)] = 1.0 / sb;
   }
   dh_x1_ = dh_x2_ = -1.0;
-  tx_terms_dl_ = tx_terms_he_ = -1.0;
   rx_hull_built_ = false;
   xae_ = std::cbrt(1.0 / (wn_ * gme_ * gme_));
 }
@@ -840,104 +510,153 @@ double ItmPath::delta_h(double x1, double x2) {
   return dh_value_;
 }
 
-ItmLoss ItmPath::loss(double rx_height_m) {
-  Geometry g;
-  g.dist = dist_;
-  g.hg[0] = hg_tx_;
-  g.hg[1] = rx_height_m;
+void ItmPath::geometry(double rx_height_m, itm_kernel::Lanes& lanes, int lane) {
+  const auto k = static_cast<std::size_t>(lane);
   const double za = z_[0] + hg_tx_, zb = z_[static_cast<std::size_t>(n_)] + rx_height_m;
   const double qc = 0.5 * gme_;
 
   // The horizons: the other terminal, unless a sample rises above the line between them (then
   // each terminal's steepest sample; the first of equals from the transmitter).
   const double chord = (zb - za) / dist_;
-  g.the[0] = chord - qc * dist_;
-  g.the[1] = -chord - qc * dist_;
-  g.dl[0] = g.dl[1] = dist_;
-  if (tx_best_angle_ > g.the[0]) {
-    g.the[0] = tx_best_angle_;
-    g.dl[0] = tx_best_distance_;
+  double the[2] = {chord - qc * dist_, -chord - qc * dist_};
+  double dl[2] = {dist_, dist_};
+  if (tx_best_angle_ > the[0]) {
+    the[0] = tx_best_angle_;
+    dl[0] = tx_best_distance_;
     const int i = receiver_horizon(zb);
     const double angle = rx_a_[static_cast<std::size_t>(i)] - zb * rx_u_[static_cast<std::size_t>(i)];
-    if (angle > g.the[1]) {
-      g.the[1] = angle;
-      g.dl[1] = dist_ - i * xi_;
+    if (angle > the[1]) {
+      the[1] = angle;
+      dl[1] = dist_ - i * xi_;
     }
   }
 
-  // Terrain irregularity between the foregrounds, then the effective heights.
-  const double xl0 = std::min(15.0 * g.hg[0], 0.1 * g.dl[0]);
-  const double xl1 = dist_ - std::min(15.0 * g.hg[1], 0.1 * g.dl[1]);
-  g.dh = delta_h(xl0, xl1);
+  // Terrain irregularity between the foregrounds, then the effective heights (of a
+  // line-of-sight path before the kernel re-derives its horizons from them).
+  const double xl0 = std::min(15.0 * hg_tx_, 0.1 * dl[0]);
+  const double xl1 = dist_ - std::min(15.0 * rx_height_m, 0.1 * dl[1]);
+  const double dh = delta_h(xl0, xl1);
   auto fit = [&](double x1, double x2) {
     int ja = 0, jb = 0;
     fit_window(x1, x2, xi_, n_, ja, jb);
     const auto a = static_cast<std::size_t>(ja), b = static_cast<std::size_t>(jb);
     return trapezoid_fit(sum_z_[b + 1] - sum_z_[a], sum_iz_[b + 1] - sum_iz_[a], z_[a], z_[b], ja, jb);
   };
-  Medium m;
-  m.wn = wn_;
-  m.ens = ns_;
-  m.gme = gme_;
-  m.zg = Complex(zg_re_, zg_im_);
-  m.inverse_abs_zg = inverse_abs_zg_;
-  m.xae = xae_;
-  // The terminal terms once the horizon distances and effective heights are final; the
-  // transmitter's from the last receiver's when those are the same.
-  auto set_terms = [&] {
-    if (g.dl[0] != tx_terms_dl_ || g.he[0] != tx_terms_he_) {
-      tx_terms_ = terminal_terms(g.dl[0], g.he[0], m);
-      tx_terms_dl_ = g.dl[0];
-      tx_terms_he_ = g.he[0];
-    }
-    g.terms[0] = tx_terms_;
-    g.terms[1] = terminal_terms(g.dl[1], g.he[1], m);
-  };
-  auto horizon = [&](double he) { return std::sqrt(2.0 * he / gme_) * std::exp(-0.07 * std::sqrt(g.dh / std::max(he, 5.0))); };
   const double z_first = z_[0], z_last = z_[static_cast<std::size_t>(n_)];
-  if (g.dl[0] + g.dl[1] > 1.5 * dist_) {
+  const bool los_geometry = dl[0] + dl[1] > 1.5 * dist_;
+  if (los_geometry) {
     const Line line = fit(xl0, xl1);
-    g.he[0] = g.hg[0] + std::max(z_first - line.at(0), 0.0);
-    g.he[1] = g.hg[1] + std::max(z_last - line.at(n_), 0.0);
-    for (int j = 0; j < 2; ++j) g.dl[j] = horizon(g.he[j]);
-    const double sum = g.dl[0] + g.dl[1];
-    if (sum <= dist_) {
-      const double scale = (dist_ / sum) * (dist_ / sum);
-      for (int j = 0; j < 2; ++j) {
-        g.he[j] *= scale;
-        g.dl[j] = horizon(g.he[j]);
-      }
-    }
-    set_terms();
-    for (int j = 0; j < 2; ++j) {
-      const double q = g.terms[j].dls;  // sqrt(2 h_e / gamma_e)
-      g.the[j] = (0.65 * g.dh * (q / g.dl[j] - 1.0) - 2.0 * g.he[j]) / q;
-    }
+    lanes.he[0][k] = hg_tx_ + std::max(z_first - line.at(0), 0.0);
+    lanes.he[1][k] = rx_height_m + std::max(z_last - line.at(n_), 0.0);
   } else {
-    g.he[0] = g.hg[0] + std::max(z_first - fit(xl0, 0.9 * g.dl[0]).at(0), 0.0);
-    g.he[1] = g.hg[1] + std::max(z_last - fit(dist_ - 0.9 * g.dl[1], xl1).at(n_), 0.0);
-    set_terms();
+    lanes.he[0][k] = hg_tx_ + std::max(z_first - fit(xl0, 0.9 * dl[0]).at(0), 0.0);
+    lanes.he[1][k] = rx_height_m + std::max(z_last - fit(dist_ - 0.9 * dl[1], xl1).at(n_), 0.0);
   }
+  lanes.hg_rx[k] = rx_height_m;
+  lanes.dh[k] = dh;
+  lanes.los_geometry[k] = los_geometry ? 1.0 : 0.0;
+  for (int j = 0; j < 2; ++j) {
+    lanes.dl[j][k] = dl[j];
+    lanes.the[j][k] = the[j];
+  }
+}
 
-  const Reference ref = reference_attenuation(g, m);
+void ItmPath::kernel_path(itm_kernel::Path& k) const {
+  k.wn = wn_;
+  k.ens = ns_;
+  k.gme = gme_;
+  k.xae = xae_;
+  k.zg_re = zg_re_;
+  k.zg_im = zg_im_;
+  k.inverse_abs_zg = inverse_abs_zg_;
+  k.ln_inverse_abs_zg = std::log(inverse_abs_zg_);
+  k.dist = dist_;
+  k.ln_dist = std::log(dist_);
+  k.hg_tx = hg_tx_;
+  k.free_space_db = free_space_path_db_;
+  k.decay_d4 = std::exp(-2.7574 * xae_ / 50e3);
+  k.decay_dist = std::exp(-dist_ / 50e3);
+  k.scatter_offset = 0.3 * xae_ * std::log(47.7 * wn_);
+  // The warnings of the frequency, the medium, the transmitter and the path length (the
+  // Algorithm's range checks less the receiver's).
+  double w = 0.0;
+  if (wn_ < 0.838 || wn_ > 210.0 || hg_tx_ < 1.0 || hg_tx_ > 1000.0 || dist_ > 1000e3) w = 1.0;
+  if (std::abs(z_time_) > 3.1 || std::abs(z_location_) > 3.1 || std::abs(z_situation_) > 3.1) w = 1.0;
+  if (ns_ < 250.0 || ns_ > 400.0 || gme_ < 75e-9 || gme_ > 250e-9 || zg_re_ <= std::abs(zg_im_) || wn_ < 0.419 ||
+      wn_ > 420.0 || hg_tx_ < 0.5 || hg_tx_ > 3000.0 || dist_ < 1e3 || dist_ > 2000e3) {
+    w = 4.0;
+  }
+  k.base_warning = w;
+  const Climate& c = kClimates[static_cast<int>(p_.climate) - 1];
+  const Curve* curves[3] = {&c.median, &c.sigma_minus, &c.sigma_plus};
+  double* out[3] = {k.median, k.sigma_minus, k.sigma_plus};
+  for (int i = 0; i < 3; ++i) {
+    const double values[5] = {curves[i]->c1, curves[i]->c2, curves[i]->x1, curves[i]->x2, curves[i]->x3};
+    std::copy(values, values + 5, out[i]);
+  }
+  k.sd = c.sd;
+  k.zd = c.zd;
+  k.g_minus = g_minus_;
+  k.g_plus = g_plus_;
+  k.dexa_frequency = dexa_frequency_m_;
+  // MDVAR's choices of deviates: single message takes the situation's for all three,
+  // accidental the situation's for locations, mobile the time's for locations.
+  k.zt = z_time_;
+  k.zl = z_location_;
+  k.zc = z_situation_;
+  switch (p_.variability) {
+    case ItmVariability::kSingleMessage: k.zt = k.zl = k.zc; break;
+    case ItmVariability::kAccidental: k.zl = k.zc; break;
+    case ItmVariability::kMobile: k.zl = k.zt; break;
+    case ItmVariability::kBroadcast: break;
+  }
+  k.variability = static_cast<int>(p_.variability);
+  k.location_variability = p_.location_variability;
+  k.situation_variability = p_.situation_variability;
+}
 
+ItmLoss ItmPath::loss(double rx_height_m) {
+  itm_kernel::Path path;
+  kernel_path(path);
+  itm_kernel::Lanes lanes;
+  for (int k = 0; k < itm_kernel::kLanes; ++k) geometry(rx_height_m, lanes, k);
+  evaluate(path, lanes);
   ItmLoss out;
-  out.warning = ref.warning;
-  out.reference_db = ref.aref;
-  out.mode = ref.mode;
-  const Statistics statistics{&kClimates[static_cast<int>(p_.climate) - 1], g_minus_, g_plus_, dexa_frequency_m_};
-  out.attenuation_db = variability(ref.aref, g, m, statistics, p_, z_time_, z_location_, z_situation_, out.warning);
+  out.loss_db = lanes.loss_db[0];
   out.free_space_db = free_space_path_db_;
-  out.loss_db = out.free_space_db + out.attenuation_db;
+  out.attenuation_db = lanes.attenuation_db[0];
+  out.reference_db = lanes.reference_db[0];
+  out.mode = static_cast<ItmMode>(static_cast<int>(lanes.mode[0]));
+  out.warning = static_cast<int>(lanes.warning[0]);
   out.surface_refractivity = ns_;
   out.earth_curvature = gme_;
-  out.delta_h_m = g.dh;
+  out.delta_h_m = lanes.dh[0];
   for (int j = 0; j < 2; ++j) {
-    out.effective_height_m[j] = g.he[j];
-    out.horizon_distance_m[j] = g.dl[j];
-    out.horizon_angle_rad[j] = g.the[j];
+    out.effective_height_m[j] = lanes.he[j][0];
+    out.horizon_distance_m[j] = lanes.dl[j][0];
+    out.horizon_angle_rad[j] = lanes.the[j][0];
   }
   return out;
+}
+
+std::size_t ItmPath::losses(std::span<const double> rx_heights_m, std::span<double> out) {
+  if (out.size() != rx_heights_m.size()) throw std::invalid_argument("ItmPath::losses: as many outputs as heights");
+  itm_kernel::Path path;
+  kernel_path(path);
+  itm_kernel::Lanes lanes;
+  std::size_t warned = 0;
+  constexpr auto kLanes = static_cast<std::size_t>(itm_kernel::kLanes);
+  for (std::size_t first = 0; first < rx_heights_m.size(); first += kLanes) {
+    const std::size_t count = std::min(kLanes, rx_heights_m.size() - first);
+    // A last, partial group repeats its last height in the spare lanes.
+    for (std::size_t k = 0; k < kLanes; ++k) geometry(rx_heights_m[first + std::min(k, count - 1)], lanes, static_cast<int>(k));
+    evaluate(path, lanes);
+    for (std::size_t k = 0; k < count; ++k) {
+      out[first + k] = lanes.loss_db[k];
+      if (lanes.warning[k] >= 3.0) ++warned;
+    }
+  }
+  return warned;
 }
 
 ItmLoss itm_point_to_point(std::span<const double> ground_m, double spacing_m, double tx_height_m, double rx_height_m,
@@ -949,49 +668,18 @@ ItmLoss itm_point_to_point(std::span<const double> ground_m, double spacing_m, d
 
 namespace itm_functions {
 
-double knife_edge_db(double v2) {
-  return v2 < 5.76 ? 6.02 + 9.11 * std::sqrt(v2) - 1.27 * v2 : 12.953 + 4.343 * std::log(v2);
-}
+// The kernel's functions on one value (in every lane; the first lane's result).
+double knife_edge_db(double v2) { return kernel::knife_edge(kernel::splat(v2))[0]; }
 
 double height_gain_db(double x, double k) {
-  if (x < 200.0) {
-    const double w = -std::log(k);
-    if (k < 1e-5 || x * w * w * w > 5495.0) return x > 1.0 ? 17.372 * std::log(x) - 117.0 : -117.0;
-    return 2.5e-5 * x * x / k - 8.686 * w - 15.0;
-  }
-  const double ln_x = std::log(x);
-  double f = 0.05751 * x - 4.343 * ln_x;
-  if (x < 2000.0) {
-    const double w = 0.0134 * x * std::exp(-0.005 * x);
-    f = (1.0 - w) * f + w * (17.372 * ln_x - 117.0);
-  }
-  return f;
+  const kernel::V xv = kernel::splat(x), kv = kernel::splat(k);
+  return kernel::height_gain(xv, kv, kernel::vlog(xv), kernel::vlog(kv))[0];
 }
 
-double frequency_gain_db(double r, double eta) {
-  static constexpr double a[5] = {25.0, 80.0, 177.0, 395.0, 705.0};
-  static constexpr double b[5] = {24.0, 45.0, 68.0, 80.0, 105.0};
-  int i = static_cast<int>(eta);  // eta >= 1 here; the curves are for eta_s = 1..5
-  double q = 0.0;
-  if (i <= 0) {
-    i = 1;
-  } else if (i >= 5) {
-    i = 5;
-  } else {
-    q = eta - i;
-  }
-  const double x = (1.0 / r) * (1.0 / r);
-  auto h = [&](int n) { return 4.343 * std::log((a[n - 1] * x + b[n - 1]) * x + 1.0); };
-  double h0 = h(i);
-  if (q != 0.0) h0 = (1.0 - q) * h0 + q * h(i + 1);
-  return h0;
-}
+double frequency_gain_db(double r, double eta) { return kernel::frequency_gain(kernel::splat(r), kernel::splat(eta))[0]; }
 
-double scatter_f_db(double theta_d) {
-  if (theta_d <= 10e3) return 133.4 + 0.332e-3 * theta_d - 4.343 * std::log(theta_d);
-  if (theta_d <= 70e3) return 104.6 + 0.212e-3 * theta_d - 1.086 * std::log(theta_d);
-  return 71.8 + 0.157e-3 * theta_d + 2.171 * std::log(theta_d);
-}
+double scatter_f_db(double theta_d) { return kernel::scatter_function(kernel::splat(theta_d))[0]; }
+
 
 double inverse_normal(double q) {
   // Hastings' rational approximation (Abramowitz and Stegun 26.2.23), |error| < 4.5e-4.

@@ -83,27 +83,38 @@ struct ItmLoss {
   double horizon_angle_rad[2] = {0, 0};  // elevation of each horizon ray
 };
 
-// Scratch space of the terrain irregularity: the resampled profile, and the last quantiles
-// found (a guess for the next, which only decides how fast they are found).
+// Scratch space of the terrain irregularity: the resampled profile, the candidates for its
+// quantiles, and the last quantiles found with the margins to search within (a guess for the
+// next, which only decides how fast they are found).
 struct DeltaHScratch {
-  std::vector<double> samples, low, high;
+  std::vector<double> samples, low, high, spare;
   double lower = std::nan(""), upper = std::nan("");
+  double low_margin = 0.02, high_margin = 0.02;  // fractions of upper - lower
 };
 
+namespace itm_kernel {
+struct Path;
+struct Lanes;
+}  // namespace itm_kernel
+
 namespace itm_detail {
-// What the reference attenuation and the statistics take from one terminal's horizon distance
-// d_L and effective height h_e alone (ItmPath keeps the transmitter's while they stay).
-struct TerminalTerms {
-  double dls = 0.0;      // the smooth-Earth horizon distance sqrt(2 h_e / gamma_e)
-  double x = 0.0;        // the horizon's part of the rounded-Earth diffraction distance (4.20)
-  double gain_db = 0.0;  // the height-gain F(x, K) of that part
-  double dexa = 0.0;     // sqrt(18e6 m h_e), the terminal's part of d_e's scale
-};
+// Which copy of the per-height kernel (itm_kernel.h) runs: "avx2" where the processor has AVX2,
+// else "baseline"; both give the same values.
+std::string kernel_name();
+// For tests: run the baseline copy even where AVX2 is there (false, the default: the best one).
+void force_baseline_kernel(bool force);
+// For tests: the kernel's own exponential, logarithm, cube root, sine and cosine (x within
+// [0, pi]) of one value.
+double kernel_exp(double x);
+double kernel_log(double x);
+double kernel_cbrt(double x);
+void kernel_sincos(double x, double& sine, double& cosine);
 }  // namespace itm_detail
 
 // One path's terrain, to be evaluated for many receiver heights: what depends on the profile
-// and the transmitter alone is computed once (set_profile), each loss() then costs O(profile
-// length) at most. Holds scratch space: one per thread.
+// and the transmitter alone is computed once (set_profile); then each height's horizons, Delta h
+// and effective heights (O(profile length) at most), and the rest of the chain for several
+// heights at once (losses()). Holds scratch space: one per thread.
 class ItmPath {
  public:
   // Throws as check_itm().
@@ -120,7 +131,16 @@ class ItmPath {
   // model (warning 4); at 0 the effective height can be 0 and the result NaN.
   ItmLoss loss(double rx_height_m);
 
+  // The basic transmission loss (dB) with the receiving antenna at each of rx_heights_m into
+  // out (the same values as loss() at each height, computed several at a time, fastest in
+  // rising order); returns how many carry warning 3 or 4. Precondition: set_profile();
+  // throws std::invalid_argument unless out has one value per height.
+  std::size_t losses(std::span<const double> rx_heights_m, std::span<double> out);
+
  private:
+  // One height's geometry (horizons, Delta h, effective heights) into lane `lane`.
+  void geometry(double rx_height_m, itm_kernel::Lanes& lanes, int lane);
+  void kernel_path(itm_kernel::Path& path) const;  // the kernel's constants of this path
   double delta_h(double x1_m, double x2_m);
   int receiver_horizon(double zb);  // the interior sample of steepest elevation seen from zb
 
@@ -137,6 +157,8 @@ class ItmPath {
   std::vector<double> sum_z_, sum_iz_;   // prefix sums of z_i and i z_i, for line fits
   std::vector<double> rx_a_, rx_u_;      // the receiver's horizon angle of sample i is
                                          // rx_a_[i] - z_rx * rx_u_[i]
+  std::vector<double> tx_angle_;         // the transmitter's horizon angle of sample i
+  std::vector<double> inverse_;          // 1 / i, as far as the longest profile yet
   // The upper envelope of those lines in z_rx (sample indices, from low z_rx to high; built
   // when a receiver first has a horizon), and the last query's place on it.
   std::vector<int> rx_hull_;
@@ -149,10 +171,6 @@ class ItmPath {
   double xae_ = 0.0;  // (k gamma_e^2)^(-1/3), the diffraction's distance scale
   double tx_best_angle_ = 0.0, tx_best_distance_ = 0.0;  // steepest interior sample from the
                                                         // transmitter
-  // The transmitter's terminal terms depend on its horizon distance and effective height
-  // only: the last ones are kept (key dl < 0: none yet).
-  double tx_terms_dl_ = -1.0, tx_terms_he_ = -1.0;
-  itm_detail::TerminalTerms tx_terms_;
   // Delta h depends on the window (x1, x2) only: the last one is kept.
   double dh_x1_ = -1.0, dh_x2_ = -1.0, dh_value_ = 0.0;
   DeltaHScratch dh_scratch_;

@@ -145,8 +145,15 @@ class DemSampler {
   double row(double lat) const { return (g_.georef.y0 - lat) / g_.georef.dy; }
   double operator()(double lat, double lon) const { return at(column(lon), row(lat)); }
   double at(double column, double row) const {
-    const double c = std::clamp(column, 0.0, static_cast<double>(g_.cols - 1));
-    const double r = std::clamp(row, 0.0, static_cast<double>(g_.rows - 1));
+    return inside(std::clamp(column, 0.0, static_cast<double>(g_.cols - 1)),
+                  std::clamp(row, 0.0, static_cast<double>(g_.rows - 1)));
+  }
+  // Whether (column, row) lies within the grid, where at() needs no clamp.
+  bool holds(double column, double row) const {
+    return column >= 0.0 && column <= g_.cols - 1 && row >= 0.0 && row <= g_.rows - 1;
+  }
+  // at() for a position the grid holds.
+  double inside(double c, double r) const {
     const int c0 = std::min(static_cast<int>(c), g_.cols - 2), r0 = std::min(static_cast<int>(r), g_.rows - 2);
     const double fc = c - c0, fr = r - r0;
     const float* row0 = &g_.heights[g_.index(r0, c0)];
@@ -289,7 +296,14 @@ void sample_profile(const io::Grid& dem, double tx_lat, double tx_lon, double rx
   // transmitter's (the same points to rounding, without two divisions per sample).
   const double c_tx = ground.column(tx_lon), r_tx = ground.row(tx_lat);
   const double dc = (ground.column(rx_lon) - c_tx) / segments, dr = (ground.row(rx_lat) - r_tx) / segments;
-  for (int m = 1; m < segments; ++m) out.ground_m[static_cast<std::size_t>(m)] = ground.at(c_tx + m * dc, r_tx + m * dr);
+  if (ground.holds(c_tx, r_tx) && ground.holds(c_tx + segments * dc, r_tx + segments * dr)) {
+    // Both ends inside the grid, so every sample between: at() without its clamps.
+    for (int m = 1; m < segments; ++m) {
+      out.ground_m[static_cast<std::size_t>(m)] = ground.inside(c_tx + m * dc, r_tx + m * dr);
+    }
+  } else {
+    for (int m = 1; m < segments; ++m) out.ground_m[static_cast<std::size_t>(m)] = ground.at(c_tx + m * dc, r_tx + m * dr);
+  }
   out.ground_m[static_cast<std::size_t>(segments)] = ground(rx_lat, rx_lon);
 }
 
@@ -302,6 +316,7 @@ struct ColumnModel::State {
   std::vector<double> x, y;
   std::vector<KnifeEdge> edges;
   std::optional<ItmPath> itm;
+  std::vector<double> losses;  // ITM's losses of one column
 
   // x, y for a profile (both models: Deygout's terrain, and the departure's geometry).
   void raise(const TerrainProfile& profile) {
@@ -399,12 +414,10 @@ std::size_t ColumnModel::path_loss(const TerrainProfile& profile, std::span<cons
     }
     s.itm->set_profile(profile.ground_m, distance / static_cast<double>(n - 1), s.tx.height_agl);
     if (!s.tx.antenna) {
-      // ITM's own loss; the pattern's geometry is not needed.
-      for (std::size_t k = 0; k < heights.size(); ++k) {
-        const ItmLoss r = s.itm->loss(heights[k]);
-        out[k] = static_cast<float>(r.loss_db);
-        if (r.warning >= 3) ++warned;
-      }
+      // ITM's own loss, all heights at once; the pattern's geometry is not needed.
+      s.losses.resize(heights.size());
+      warned = s.itm->losses(heights, s.losses);
+      for (std::size_t k = 0; k < heights.size(); ++k) out[k] = static_cast<float>(s.losses[k]);
       return warned;
     }
   }

@@ -4,13 +4,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "volume/itm_reference.h"
 
 namespace terravol::volume {
 namespace {
@@ -130,6 +135,142 @@ TEST(Itm, EffectiveEarthFromSurfaceRefractivity) {
   const ItmLoss up = itm_point_to_point(plateau, 100.0, 30.0, 10.0, 100.0, p);
   EXPECT_NEAR(up.surface_refractivity, 270.806, 0.001);
   EXPECT_NEAR(157e-9 / up.earth_curvature, 1.2678, 0.0001);
+}
+
+// The straightforward evaluation the fast path is checked against (volume/itm_reference.h)
+// gives NTIA's published losses too.
+TEST(ItmReference, MatchesNtiaPublishedPointToPointCases) {
+  for (const auto& c : published_cases()) {
+    SCOPED_TRACE(std::to_string(c.f) + " MHz");
+    const reference::ReferenceLoss r = reference::itm_reference(c.profile, c.spacing, c.h_tx, c.h_rx, c.f, parameters_of(c));
+    EXPECT_NEAR(r.loss_db, c.loss_db, c.f == 3500.0 ? 0.05 : 0.0051);
+  }
+}
+
+// ItmPath, which shares the profile's work between the heights of a column (horizons from an
+// envelope, prefix sums, Delta h kept and its quantiles guessed) and evaluates the rest of the
+// chain four heights at a time with its own exponential and logarithm (itm_kernel.h), against
+// the straightforward evaluation of each point on its own: random profiles from flat to
+// mountainous, short to troposcatter range, every climate, both polarizations, all four
+// variability modes; the heights of a column at once (as terravol rf runs them, on both copies
+// of the kernel, and equal to loss() height by height), then one by one in rising and in random
+// order.
+TEST(ItmFastPath, EqualsTheStraightforwardEvaluationOfEachPoint) {
+  std::mt19937 rng(190419);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int points = 0, undefined = 0;
+  double worst = 0.0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 2 + static_cast<int>(600 * unit(rng) * unit(rng));
+    const double spacing = 20.0 + (unit(rng) < 0.1 ? 2000.0 : 150.0) * unit(rng);
+    const double relief = 1500.0 * unit(rng) * unit(rng);
+    const double base = 2500.0 * unit(rng);
+    const double wave = 2.0 + 60.0 * unit(rng);
+    const double noise = unit(rng) < 0.3 ? 0.0 : 50.0 * unit(rng);
+    std::vector<double> z;
+    for (int i = 0; i <= n; ++i) {
+      const double v = base + relief * (0.5 + 0.5 * std::sin(i / wave + trial)) + noise * unit(rng);
+      z.push_back(unit(rng) < 0.2 ? std::round(v) : v);  // DEMs hold whole metres
+    }
+    ItmParameters p;
+    p.polarization = unit(rng) < 0.5 ? ItmPolarization::kHorizontal : ItmPolarization::kVertical;
+    p.permittivity = 4.0 + 76.0 * unit(rng);
+    p.conductivity = 0.001 * std::pow(5000.0, unit(rng));
+    p.refractivity = 250.0 + 150.0 * unit(rng);
+    p.climate = static_cast<ItmClimate>(1 + static_cast<int>(7 * unit(rng)) % 7);
+    p.time = 0.01 + 0.98 * unit(rng);
+    p.location = 0.01 + 0.98 * unit(rng);
+    p.situation = 0.01 + 0.98 * unit(rng);
+    p.variability = static_cast<ItmVariability>(static_cast<int>(4 * unit(rng)) % 4);
+    p.location_variability = unit(rng) < 0.5;
+    p.situation_variability = unit(rng) < 0.8;
+    const double f = 20.0 * std::pow(1000.0, unit(rng));
+    const double tx = 0.5 + (unit(rng) < 0.5 ? 50.0 : 1000.0) * unit(rng);
+    std::vector<double> heights;
+    const double first = 0.5 + 20.0 * unit(rng), step = 1.0 + 60.0 * unit(rng);
+    for (int k = 0; k < 31; ++k) heights.push_back(first + step * k);
+    std::vector<double> shuffled = heights;
+    std::shuffle(shuffled.begin(), shuffled.end(), rng);
+    shuffled.insert(shuffled.begin(), heights.begin(), heights.end());
+    ItmPath path(f, p);
+    path.set_profile(z, spacing, tx);
+    // The column at once (as terravol rf runs it) on both copies of the kernel, which agree
+    // to the bit.
+    std::vector<double> column(heights.size()), baseline(heights.size());
+    path.losses(heights, column);
+    itm_detail::force_baseline_kernel(true);
+    path.losses(heights, baseline);
+    itm_detail::force_baseline_kernel(false);
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      ASSERT_TRUE(column[k] == baseline[k] || (std::isnan(column[k]) && std::isnan(baseline[k])))
+          << "trial " << trial << ": " << column[k] << " (" << itm_detail::kernel_name() << ") against " << baseline[k];
+      const ItmLoss one = path.loss(heights[k]);
+      ASSERT_TRUE(column[k] == one.loss_db || (std::isnan(column[k]) && std::isnan(one.loss_db))) << "trial " << trial;
+    }
+    for (const double h : shuffled) {
+      const ItmLoss fast = path.loss(h);
+      const reference::ReferenceLoss plain = reference::itm_reference(z, spacing, tx, h, f, p);
+      ++points;
+      if (std::isnan(plain.loss_db)) {
+        // The Algorithm itself fails on a few short paths with tall masts at low frequencies
+        // (a logarithm of a negative number); then so must the fast path.
+        ASSERT_TRUE(std::isnan(fast.loss_db)) << "trial " << trial << ", receiver " << h << " m";
+        ++undefined;
+        continue;
+      }
+      ASSERT_NEAR(fast.loss_db, plain.loss_db, 1e-6) << "trial " << trial << ", " << n << " samples of " << spacing << " m, "
+                                                     << f << " MHz, antennas " << tx << " m and " << h << " m";
+      ASSERT_EQ(fast.warning, plain.warning) << "trial " << trial << ", receiver " << h << " m";
+      worst = std::max(worst, std::abs(fast.loss_db - plain.loss_db));
+    }
+  }
+  EXPECT_EQ(points, 400 * 62);
+  EXPECT_LT(undefined, points / 100);
+  std::printf("largest difference %.3g dB over %d points (%d undefined in both)\n", worst, points, undefined);
+}
+
+// The kernel's own functions (itm_kernel.h) against the C library's: within a few units in the
+// last place over the ranges the model uses and beyond, and the special values.
+TEST(ItmFunctions, KernelMathAgreesWithTheCLibrary) {
+  using itm_detail::kernel_cbrt;
+  using itm_detail::kernel_exp;
+  using itm_detail::kernel_log;
+  std::mt19937 rng(1995);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  constexpr double kUlp = 2.220446049250313e-16;
+  double worst_exp = 0.0, worst_log = 0.0, worst_cbrt = 0.0, worst_trig = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double x = -708.0 + 1417.0 * unit(rng);
+    const double e = std::exp(x);
+    worst_exp = std::max(worst_exp, std::abs(kernel_exp(x) - e) / e);
+    const double small = (unit(rng) - 0.5) * 2.0;  // near 0, where ITM's arguments mostly are
+    worst_exp = std::max(worst_exp, std::abs(kernel_exp(small) - std::exp(small)) / std::exp(small));
+    const double y = std::exp(-745.0 + 1454.0 * unit(rng));  // subnormal to 1e308
+    worst_log = std::max(worst_log, std::abs(kernel_log(y) - std::log(y)) / std::max(1.0, std::abs(std::log(y))));
+    const double near_one = 1.0 + (unit(rng) - 0.5) * 1e-3;
+    worst_log = std::max(worst_log, std::abs(kernel_log(near_one) - std::log(near_one)));
+    const double c = std::exp(-100.0 + 200.0 * unit(rng));
+    worst_cbrt = std::max(worst_cbrt, std::abs(kernel_cbrt(c) - std::cbrt(c)) / std::cbrt(c));
+    const double a = M_PI * unit(rng);
+    double s = 0.0, co = 0.0;
+    itm_detail::kernel_sincos(a, s, co);
+    worst_trig = std::max({worst_trig, std::abs(s - std::sin(a)), std::abs(co - std::cos(a))});
+  }
+  EXPECT_LT(worst_exp, 4.0 * kUlp);
+  EXPECT_LT(worst_log, 4.0 * kUlp);
+  EXPECT_LT(worst_cbrt, 40.0 * kUlp);  // through ln and exp of a third of it (ln x up to 230)
+  EXPECT_LT(worst_trig, 4.0 * kUlp);
+  std::printf("largest errors: exp %.2g, log %.2g, cbrt %.2g, sin/cos %.2g (units in the last place: %.2g)\n", worst_exp,
+              worst_log, worst_cbrt, worst_trig, kUlp);
+  EXPECT_EQ(kernel_exp(0.0), 1.0);
+  EXPECT_EQ(kernel_exp(-1000.0), 0.0);
+  EXPECT_EQ(kernel_exp(1000.0), INFINITY);
+  EXPECT_TRUE(std::isnan(kernel_exp(std::nan(""))));
+  EXPECT_EQ(kernel_log(1.0), 0.0);
+  EXPECT_EQ(kernel_log(0.0), -INFINITY);
+  EXPECT_EQ(kernel_log(INFINITY), INFINITY);
+  EXPECT_TRUE(std::isnan(kernel_log(-1.0)));
+  EXPECT_TRUE(std::isnan(kernel_log(std::nan(""))));
 }
 
 TEST(ItmFunctions, KnifeEdgeIsAboutSixDbAtGrazingAndContinuous) {

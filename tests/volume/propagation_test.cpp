@@ -7,10 +7,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 
 #include "io/mosaic.h"
+#include "shared_data.h"
+#include "volume/itm_reference.h"
 #include "volume_test_util.h"
 #include "io/scene_frame.h"
 #include "volume/readers.h"
@@ -452,6 +455,68 @@ TEST(RfItm, EachColumnIsItmOverItsOwnProfile) {
 
 TEST(RfItm, AntennaPatternAddsItsAttenuationAlongTheDeparture) {
   expect_pattern_attenuation_along_the_departure(itm_options());
+}
+
+// Every point of seeded random columns of `rf --model itm` volumes equals the straightforward
+// evaluation of ITM on that point alone (volume/itm_reference.h: no work shared between the
+// heights, the profile's searches and fits done afresh) on the column's own profile, to the
+// float the volume stores: over the rolling hills, and over the Utah tiles (the bench's
+// lattice: 3", 31 heights 10..310 m, 900 MHz) from the valley and from Farnsworth Peak.
+void expect_columns_equal_the_straightforward_itm(const io::Grid& dem, const Transmitter& tx, const RfGrid& grid,
+                                                  const RfOptions& o, int columns, unsigned seed) {
+  const Volume v = compute_rf(dem, tx, grid, o).path_loss;
+  const io::SceneFrame frame(tx.lat, tx.lon);
+  const double step = std::min(dem.georef.dx * frame.metres_per_degree_lon(), dem.georef.dy * frame.metres_per_degree_lat());
+  std::mt19937 rng(seed);
+  int checked = 0;
+  double worst = 0.0;
+  for (int c = 0; c < columns; ++c) {
+    const int i = std::uniform_int_distribution<int>(0, v.lattice.dims[0] - 1)(rng);
+    const int j = std::uniform_int_distribution<int>(0, v.lattice.dims[1] - 1)(rng);
+    TerrainProfile profile;
+    sample_profile(dem, tx.lat, tx.lon, v.lattice.world(1, j), v.lattice.world(0, i), step, profile);
+    if (profile.distance_m < 1.0) continue;  // the transmitter's own column
+    const double spacing = profile.distance_m / static_cast<double>(profile.ground_m.size() - 1);
+    for (int k = 0; k < v.lattice.dims[2]; ++k) {
+      const double expected =
+          reference::itm_reference(profile.ground_m, spacing, tx.height_agl, v.lattice.world(2, k), tx.frequency_mhz, o.itm).loss_db;
+      const float rounded = static_cast<float>(expected);
+      const double half_ulp = 0.5 * (std::nextafter(rounded, INFINITY) - rounded);
+      ASSERT_NEAR(v.at(i, j, k), expected, half_ulp + 1e-6) << "column " << i << " " << j << ", height " << v.lattice.world(2, k);
+      worst = std::max(worst, std::abs(v.at(i, j, k) - expected));
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, (columns - 1) * v.lattice.dims[2]);
+  std::printf("%d points, largest difference %.3g dB (the volume holds floats)\n", checked, worst);
+}
+
+RfGrid bench_like_grid(double radius_km, double spacing_arcsec) {
+  RfGrid grid;
+  grid.radius_km = radius_km;
+  grid.spacing_arcsec = spacing_arcsec;
+  for (int k = 0; k < 31; ++k) grid.heights_agl.push_back(10.0 + 10.0 * k);
+  return grid;
+}
+
+TEST(RfItm, ColumnsEqualTheStraightforwardEvaluationOverHills) {
+  RfOptions o = itm_options();
+  o.itm.climate = ItmClimate::kMaritimeTemperateOverLand;
+  o.itm.time = 0.9;
+  expect_columns_equal_the_straightforward_itm(hilly_dem(), kHillyTx, bench_like_grid(6.0, 15.0), o, 120, 1919);
+}
+
+TEST(RfItm, ColumnsEqualTheStraightforwardEvaluationOverTheUtahTiles) {
+  const auto tiles = test::shared_dem("utah_sdf");
+  TERRAVOL_REQUIRE_SHARED(tiles);
+  const io::Mosaic mosaic = io::Mosaic::open({tiles});
+  const RfGrid grid = bench_like_grid(8.0, 3.0);
+  for (const Transmitter& tx : {Transmitter{40.76, -111.89, 30.0, 900.0, std::nullopt, {}, {}},
+                               Transmitter{40.6589, -112.2019, 30.0, 900.0, std::nullopt, {}, {}}}) {
+    SCOPED_TRACE(std::to_string(tx.lat) + ", " + std::to_string(tx.lon));
+    const RfWindow window = read_rf_window(mosaic, rf_area(tx, grid.radius_km));
+    expect_columns_equal_the_straightforward_itm(window.grid, tx, grid, itm_options(), 150, 4242);
+  }
 }
 
 // rf_path with ITM is compute_rf's value at the lattice point, its terms add up, it has no
