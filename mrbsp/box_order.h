@@ -4,6 +4,7 @@
 // buckets while it walks the decided tree and emits them there.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <unordered_map>
@@ -73,13 +74,18 @@ struct BoxScratch {
   std::vector<Tri> tris;                                  // what the last emit_* call emitted
   // Scratch of the distribution.
   std::vector<std::pair<Part, std::uint64_t>> work;
-  std::vector<glm::dvec3> clip_a, clip_b, clip_c, clip_d, keep_, below_;
   std::vector<std::int32_t> order;
-  struct Item {  // a polygon on its way down a small BSP
-    std::int32_t node;
-    std::uint32_t first, count;  // into clip_c
+  struct Poly3 {  // a convex polygon being cut, in place
+    static constexpr int kMax = 16;
+    std::array<glm::dvec3, kMax> v;
+    int n = 0;
+  };
+  struct Item {  // a box (poly -1) or one of its faces (a polygon of poly_pool_) on its way down a small BSP
+    std::int32_t node, poly;
+    int face;
   };
   std::vector<Item> bsp_stack_;
+  std::vector<Poly3> poly_pool_;
   glm::dvec3 eye_{0.0};
   BoxStats stats;
   bool active = false;

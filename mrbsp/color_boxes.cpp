@@ -108,32 +108,48 @@ void face_corners(int f, const glm::vec3& lo, const glm::vec3& hi, glm::dvec3 ou
 // Sutherland-Hodgman against one plane: the parts of the convex polygon `in` with
 // dot(n, p) + d >= 0 (front) and <= 0 (back). Vertices within tol of the plane go to both.
 // Returns -1 when all of it lies behind (within tol), +1 in front (or in the plane), 0 when cut.
-int split(const std::vector<glm::dvec3>& in, const glm::dvec3& n, double d, double tol, std::vector<glm::dvec3>& front,
-          std::vector<glm::dvec3>& back) {
+// A cut adds at most one vertex to each part; a polygon already holding Poly3::kMax vertices
+// is not cut but goes to the side of its vertices' mean distance.
+int split(const BoxScratch::Poly3& in, const glm::dvec3& n, double d, double tol, BoxScratch::Poly3& front,
+          BoxScratch::Poly3& back) {
   bool any_front = false, any_back = false;
-  for (const glm::dvec3& p : in) {
-    const double s = glm::dot(n, p) + d;
-    any_front |= s > tol;
-    any_back |= s < -tol;
+  double s[BoxScratch::Poly3::kMax];
+  double mean = 0.0;
+  for (int k = 0; k < in.n; ++k) {
+    s[k] = glm::dot(n, in.v[static_cast<std::size_t>(k)]) + d;
+    mean += s[k];
+    any_front |= s[k] > tol;
+    any_back |= s[k] < -tol;
   }
   if (!any_back) return 1;
   if (!any_front) return -1;
-  front.clear();
-  back.clear();
-  const std::size_t count = in.size();
-  for (std::size_t k = 0; k < count; ++k) {
-    const glm::dvec3& a = in[k];
-    const glm::dvec3& b = in[(k + 1) % count];
-    const double sa = glm::dot(n, a) + d, sb = glm::dot(n, b) + d;
-    if (sa >= -tol) front.push_back(a);
-    if (sa <= tol) back.push_back(a);
+  if (in.n + 1 > BoxScratch::Poly3::kMax) return mean >= 0.0 ? 1 : -1;
+  front.n = 0;
+  back.n = 0;
+  for (int k = 0; k < in.n; ++k) {
+    const int k1 = k + 1 == in.n ? 0 : k + 1;
+    const glm::dvec3& a = in.v[static_cast<std::size_t>(k)];
+    const double sa = s[k], sb = s[k1];
+    if (sa >= -tol) front.v[static_cast<std::size_t>(front.n++)] = a;
+    if (sa <= tol) back.v[static_cast<std::size_t>(back.n++)] = a;
     if ((sa > tol && sb < -tol) || (sa < -tol && sb > tol)) {
+      const glm::dvec3& b = in.v[static_cast<std::size_t>(k1)];
       const glm::dvec3 x = a + (b - a) * (sa / (sa - sb));
-      front.push_back(x);
-      back.push_back(x);
+      front.v[static_cast<std::size_t>(front.n++)] = x;
+      back.v[static_cast<std::size_t>(back.n++)] = x;
     }
   }
   return 0;
+}
+
+// The face f of the box (lo, hi) as a polygon.
+BoxScratch::Poly3 face_polygon(int f, const glm::vec3& lo, const glm::vec3& hi) {
+  BoxScratch::Poly3 p;
+  glm::dvec3 c[4];
+  face_corners(f, lo, hi, c);
+  for (int k = 0; k < 4; ++k) p.v[static_cast<std::size_t>(k)] = c[k];
+  p.n = 4;
+  return p;
 }
 
 double window_tolerance(const TerrainTree::Impl& m) {
@@ -214,51 +230,80 @@ std::int32_t BoxScratch::bsp(std::int32_t slot, std::int32_t node, int side) con
 void BoxScratch::insert_into_slot(const TerrainTree::Impl& m, std::int32_t slot, const Part& p, double tol) {
   const BspStore& store = *m.slots[static_cast<std::size_t>(slot)].store;
   slot_boxed[static_cast<std::size_t>(slot)] = 1;
-  const glm::dvec3 eye = eye_;
-  std::vector<glm::dvec3>& pool = clip_c;
-  for (int f = 0; f < 6; ++f) {
-    if (!(p.faces & (1u << f)) || !faces_eye(f, p.lo, p.hi, eye)) continue;
-    const glm::u8vec4 rgba = boxes[p.box].rgba[static_cast<std::size_t>(f)];
-    ++stats.faces;
-    ++stats.bsp_faces;
-    pool.clear();
-    glm::dvec3 corners[4];
-    face_corners(f, p.lo, p.hi, corners);
-    pool.insert(pool.end(), corners, corners + 4);
-    if (store.root < 0) {  // an empty store: one region
-      add_poly(bsp_key(slot, kRootless, 0), pool.data(), 4, rgba);
+  int faces[3], count = 0;
+  for (int f = 0; f < 6; ++f)
+    if ((p.faces & (1u << f)) && faces_eye(f, p.lo, p.hi, eye_)) faces[count++] = f;
+  if (count == 0) return;
+  stats.faces += static_cast<std::size_t>(count);
+  stats.bsp_faces += static_cast<std::size_t>(count);
+  const auto colour = [&](int f) { return boxes[p.box].rgba[static_cast<std::size_t>(f)]; };
+  if (store.root < 0) {  // an empty store: one region
+    for (int q = 0; q < count; ++q) {
+      const Poly3 poly = face_polygon(faces[q], p.lo, p.hi);
+      add_poly(bsp_key(slot, kRootless, 0), poly.v.data(), static_cast<std::size_t>(poly.n), colour(faces[q]));
+    }
+    return;
+  }
+  // The box goes down whole while a plane leaves it on one side (one test for all its faces);
+  // where a plane passes through it, its faces go on as polygons, cut where needed.
+  const glm::dvec3 centre = 0.5 * (glm::dvec3(p.lo) + glm::dvec3(p.hi)), half = 0.5 * (glm::dvec3(p.hi) - glm::dvec3(p.lo));
+  std::vector<Item>& stack = bsp_stack_;
+  std::vector<Poly3>& pool = poly_pool_;
+  pool.clear();
+  stack.assign(1, Item{store.root, -1, 0});
+  const auto arrive = [&](std::int32_t node, int side, const Poly3& poly, int face) {
+    add_poly(bsp_key(slot, node, side), poly.v.data(), static_cast<std::size_t>(poly.n), colour(face));
+  };
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const BspNode& bn = store.nodes[static_cast<std::size_t>(it.node)];
+    const glm::dvec3 n(bn.n);
+    const double d = static_cast<double>(bn.d);
+    if (it.poly < 0) {  // the whole box
+      const double s = glm::dot(n, centre) + d, r = glm::dot(glm::abs(n), half);
+      int side = -1;
+      if (s - r >= -tol) side = 1;
+      else if (s + r <= tol) side = 0;
+      if (side >= 0) {
+        const std::int32_t child = side ? bn.front : bn.back;
+        if (child >= 0) {
+          stack.push_back(Item{child, -1, 0});
+        } else if (child == kDropSide) {
+          stats.dropped += static_cast<std::size_t>(count);
+        } else {
+          for (int q = 0; q < count; ++q) arrive(it.node, side, face_polygon(faces[q], p.lo, p.hi), faces[q]);
+        }
+        continue;
+      }
+      // Cut here: each face from this node on as a polygon.
+      for (int q = 0; q < count; ++q) {
+        pool.push_back(face_polygon(faces[q], p.lo, p.hi));
+        stack.push_back(Item{it.node, static_cast<std::int32_t>(pool.size() - 1), faces[q]});
+      }
       continue;
     }
-    std::vector<Item>& stack = bsp_stack_;
-    stack.assign(1, Item{store.root, 0, 4});
-    while (!stack.empty()) {
-      const Item it = stack.back();
-      stack.pop_back();
-      const BspNode& bn = store.nodes[static_cast<std::size_t>(it.node)];
-      clip_a.assign(pool.begin() + it.first, pool.begin() + it.first + it.count);
-      const int s = split(clip_a, glm::dvec3(bn.n), static_cast<double>(bn.d), tol, clip_b, clip_d);
-      const auto go = [&](int side, const std::vector<glm::dvec3>& piece) {
-        const std::int32_t child = side ? bn.front : bn.back;
-        if (child == kDropSide) {
-          ++stats.dropped;
-          return;
-        }
-        if (child < 0) {
-          add_poly(bsp_key(slot, it.node, side), piece.data(), piece.size(), rgba);
-          return;
-        }
-        const auto first = static_cast<std::uint32_t>(pool.size());
-        pool.insert(pool.end(), piece.begin(), piece.end());
-        stack.push_back({child, first, static_cast<std::uint32_t>(piece.size())});
-      };
-      if (s > 0) {
-        go(1, clip_a);
-      } else if (s < 0) {
-        go(0, clip_a);
+    const Poly3 poly = pool[static_cast<std::size_t>(it.poly)];
+    Poly3 front, back;
+    const int s = split(poly, n, d, tol, front, back);
+    const auto go = [&](int side, const Poly3& piece) {
+      const std::int32_t child = side ? bn.front : bn.back;
+      if (child == kDropSide) {
+        ++stats.dropped;
+      } else if (child < 0) {
+        arrive(it.node, side, piece, it.face);
       } else {
-        go(1, clip_b);
-        go(0, clip_d);
+        pool.push_back(piece);
+        stack.push_back(Item{child, static_cast<std::int32_t>(pool.size() - 1), it.face});
       }
+    };
+    if (s > 0) {
+      go(1, poly);
+    } else if (s < 0) {
+      go(0, poly);
+    } else {
+      go(1, front);
+      go(0, back);
     }
   }
 }
@@ -314,22 +359,28 @@ void BoxScratch::distribute(TerrainTree::Impl& m, const Camera& camera, const De
       if (!(p.faces & (1u << f)) || !faces_eye(f, p.lo, p.hi, eye_)) continue;
       ++stats.faces;
       const glm::u8vec4 rgba = boxes[p.box].rgba[static_cast<std::size_t>(f)];
-      glm::dvec3 corners[4];
-      face_corners(f, p.lo, p.hi, corners);
-      clip_a.assign(corners, corners + 4);
-      const int s_diag = split(clip_a, dn, dd, tol, clip_b, clip_c);
-      const std::vector<glm::dvec3>* halves[2] = {nullptr, nullptr};  // south-east, north-west
-      if (s_diag < 0) halves[0] = &clip_a; else if (s_diag > 0) halves[1] = &clip_a; else { halves[0] = &clip_c; halves[1] = &clip_b; }
+      const Poly3 face = face_polygon(f, p.lo, p.hi);
+      Poly3 north_west, south_east;
+      const int s_diag = split(face, dn, dd, tol, north_west, south_east);
+      const Poly3* halves[2] = {nullptr, nullptr};  // south-east (behind the diagonal plane), north-west
+      if (s_diag < 0) {
+        halves[0] = &face;
+      } else if (s_diag > 0) {
+        halves[1] = &face;
+      } else {
+        halves[0] = &south_east;
+        halves[1] = &north_west;
+      }
       for (int h = 0; h < 2; ++h) {
         if (halves[h] == nullptr) continue;
-        std::vector<glm::dvec3>& keep = keep_;
-        const int st = split(*halves[h], tn[h], td[h], tol, keep, below_);
+        Poly3 keep, below;
+        const int st = split(*halves[h], tn[h], td[h], tol, keep, below);
         if (st < 0) {
           ++stats.dropped;
           continue;
         }
-        const std::vector<glm::dvec3>& piece = st > 0 ? *halves[h] : keep;
-        add_poly(cell_key(kKeyLeaf, r.level_index, r.ci, r.cj, h), piece.data(), piece.size(), rgba);
+        const Poly3& piece = st > 0 ? *halves[h] : keep;
+        add_poly(cell_key(kKeyLeaf, r.level_index, r.ci, r.cj, h), piece.v.data(), static_cast<std::size_t>(piece.n), rgba);
       }
     }
   };
