@@ -227,7 +227,8 @@ void ColorCubeOctree::set_transfer(const DensitySpec& spec) {
 }
 
 std::size_t ColorCubeOctree::bytes() const {
-  std::size_t b = values_.capacity() * sizeof(float) + base_.capacity() * sizeof(std::int32_t) + weight_.capacity() * sizeof(float);
+  std::size_t b = values_.capacity() * sizeof(float) + base_.capacity() * sizeof(std::int32_t) + weight_.capacity() * sizeof(float) +
+                  entries_.capacity() * sizeof(std::int16_t);
   for (const auto& l : packed_) b += l.capacity() * sizeof(Packed);
   for (const auto& l : filled_) b += l.capacity() * sizeof(std::array<std::int32_t, 2>);
   return b;
@@ -269,10 +270,13 @@ void ColorCubeOctree::cell_box(int level, int i, int j, int k, glm::dvec3& lo, g
 
 Faces ColorCubeOctree::leaf_faces(int i, int j, int k) const {
   const TransferTable& t = *table_;
+  const std::size_t nx = static_cast<std::size_t>(grid_.boxes[0]) + 1, ny = static_cast<std::size_t>(grid_.boxes[1]) + 1;
+  const std::size_t base = (static_cast<std::size_t>(k) * ny + static_cast<std::size_t>(j)) * nx + static_cast<std::size_t>(i);
   int entry[8];
   bool any = false;
   for (int c = 0; c < 8; ++c) {
-    entry[c] = t.entry(corner_value(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2)));
+    entry[c] = entries_[base + static_cast<std::size_t>(c & 1) + static_cast<std::size_t>((c >> 1) & 1) * nx +
+                        static_cast<std::size_t>(c >> 2) * nx * ny];
     any |= entry[c] >= 0;
   }
   Faces f{};
@@ -333,6 +337,19 @@ Faces ColorCubeOctree::build_cell(int level, int i, int j, int k) {
 void ColorCubeOctree::build_all() {
   const auto t0 = std::chrono::steady_clock::now();
   table_.emplace(spec_, grid_.size * 0.5);
+  {
+    // Every box corner's entry, in parallel over the corner layers.
+    const std::size_t nx = static_cast<std::size_t>(grid_.boxes[0]) + 1, ny = static_cast<std::size_t>(grid_.boxes[1]) + 1;
+    const std::size_t nz = static_cast<std::size_t>(grid_.boxes[2]) + 1;
+    entries_.assign(nx * ny * nz, -1);
+    tbb::parallel_for(std::size_t{0}, nz, [&](std::size_t k) {
+      for (std::size_t j = 0; j < ny; ++j)
+        for (std::size_t i = 0; i < nx; ++i) {
+          const int e = table_->entry(corner_value(static_cast<int>(i), static_cast<int>(j), static_cast<int>(k)));
+          entries_[(k * ny + j) * nx + i] = static_cast<std::int16_t>(e);
+        }
+    });
+  }
   packed_.assign(dims_.size(), {});
   for (std::size_t lv = 1; lv < dims_.size(); ++lv) {
     const auto& d = dims_[lv];
@@ -436,6 +453,8 @@ void ColorCubeOctree::refine(const mrbsp::Camera& camera, const RefineOptions& o
     for (int q = 0; q < 6; ++q) {
       const glm::vec4& v = f[static_cast<std::size_t>(q)];
       if (!(v.a > 0.0f)) continue;
+      // Only the faces that face the eye are drawn (mrbsp::ColorBox); the others stay clear.
+      if (!((q & 1) ? eye[q / 2] > hi[q / 2] : eye[q / 2] < lo[q / 2])) continue;
       const glm::vec3 c = glm::clamp(glm::vec3(v) / v.a, 0.0f, 1.0f);
       const double scale = projected > 0.0 ? area[q / 2] / projected : 1.0;
       const double alpha = v.a >= 1.0f ? 1.0 : -std::expm1(scale * std::log1p(-static_cast<double>(v.a)));

@@ -139,6 +139,9 @@ class ColorCubeOctree {
   // Per level, per column block: the box heights a cell there may hold data in.
   std::vector<std::vector<std::array<std::int32_t, 2>>> filled_;
   std::optional<TransferTable> table_;
+  // Per box corner (x fastest, then y, then z): its transfer table entry, -1 clear; made with
+  // each transfer function (each corner is shared by eight leaves).
+  std::vector<std::int16_t> entries_;
   std::vector<std::vector<Packed>> packed_;  // per level >= 1
   double build_ms_ = 0.0, resample_ms_ = 0.0;
 };
