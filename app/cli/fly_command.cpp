@@ -28,6 +28,7 @@
 #include "app/scene/mosaic_lattice.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
+#include "density/transfer.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::cli {
@@ -50,6 +51,8 @@ struct FlyOptions {
   int samples = 1;
   bool resume = false, force = false;
   std::vector<std::string> objects;  // --object, added to the scene's
+  std::string density;               // --density: replaces every volume's density style
+  std::optional<double> density_threshold;
 };
 
 bool is_video(const std::filesystem::path& p) {
@@ -107,6 +110,10 @@ void run_fly(const FlyOptions& o) {
     if (!std::filesystem::exists(v.file)) throw std::invalid_argument(source + ": scene: " + v.file.string() + ": no such file");
   }
   for (scene::ObjectSpec& obj : parse_objects(o.objects)) scene.objects.push_back(std::move(obj));
+  if (!o.density.empty()) {
+    const density::DensitySpec d = density::parse_density(o.density);
+    for (scene::VolumeSpec& v : scene.volumes) v.density = d;
+  }
   // Size and LOD: --size and --threshold over the scene's "render" object over the defaults.
   scene::SceneStyle given;
   if (!o.size.empty()) {
@@ -116,6 +123,7 @@ void run_fly(const FlyOptions& o) {
     given.height = h;
   }
   given.threshold = o.threshold;
+  given.density_threshold = o.density_threshold;
   const scene::SceneStyle style = scene::overlay(scene.style, given);
   const scene::Style st = scene::resolve_style(style);
   const int width = st.width, height = st.height;
@@ -225,7 +233,9 @@ void run_fly(const FlyOptions& o) {
   render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
   settings.height = height * factor;
-  render::SceneRenderer renderer(std::move(mosaic), scene, settings, render::scene_options(st));
+  render::SceneOptions options = render::scene_options(st);
+  options.density.threshold_px *= factor;  // in output pixels, like the LOD threshold
+  render::SceneRenderer renderer(std::move(mosaic), scene, settings, options);
 
   const scene::CameraPath path(
       file.keys, renderer.frame(), [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); },
@@ -327,7 +337,7 @@ void add_fly_command(CLI::App& app) {
                                         "(needs an X display; docs/camera-paths.md)");
   auto o = std::make_shared<FlyOptions>();
   struct Raw {
-    double threshold = 0, start = 0, end = 0;
+    double threshold = 0, start = 0, end = 0, density_threshold = 0;
   };
   auto raw = std::make_shared<Raw>();
   cmd->add_option("path", o->path, "Camera path file (JSON)")->required();
@@ -336,6 +346,8 @@ void add_fly_command(CLI::App& app) {
   cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT, pixels (default: the scene's, else 1280x720)");
   auto* threshold = cmd->add_option("--threshold", raw->threshold,
                                     "LOD threshold in pixels for keys without their own (default: the scene's, else 2)");
+  add_density_option(*cmd, o->density);
+  auto* density_threshold = add_density_threshold_option(*cmd, raw->density_threshold);
   cmd->add_option("--crf", o->crf, "H.264 quality, 0 (lossless) .. 51 (worst)")->capture_default_str();
   auto* start = cmd->add_option("--start", raw->start, "First time to export, seconds on the path's clock");
   auto* end = cmd->add_option("--end", raw->end, "Last time to export, seconds on the path's clock");
@@ -347,7 +359,7 @@ void add_fly_command(CLI::App& app) {
                   "Antialiasing: samples per pixel, 1, 4, 9 or 16 (supersampling: rendered at 1x, 2x, 3x or 4x "
                   "the size and box-filtered down)")
       ->capture_default_str();
-  cmd->callback([o, raw, threshold, start, end] {
+  cmd->callback([o, raw, threshold, start, end, density_threshold] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
     if (o->samples != 1 && o->samples != 4 && o->samples != 9 && o->samples != 16) {
@@ -360,6 +372,8 @@ void add_fly_command(CLI::App& app) {
       }
       o->threshold = raw->threshold;
     }
+    if (density_threshold->count() > 0) o->density_threshold = raw->density_threshold;
+    if (!o->density.empty()) density::parse_density(o->density);  // bad text fails before any work
     if (start->count() > 0) o->start = raw->start;
     if (end->count() > 0) o->end = raw->end;
     if (!o->size.empty()) {

@@ -51,6 +51,7 @@ SceneOptions scene_options(const scene::Style& style, int levels, Sliding slidin
   o.markers = style.markers;
   o.surface_triangles = style.surface_triangles;
   o.sliding = sliding;
+  o.density.threshold_px = style.density_threshold;
   return o;
 }
 
@@ -70,7 +71,7 @@ SceneRenderer::SceneRenderer(const scene::SceneSpec& scene, const RenderSettings
 
 SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
                              const SceneOptions& options)
-    : mosaic_(std::move(mosaic)), settings_(settings), options_(options) {
+    : mosaic_(std::move(mosaic)), settings_(settings), options_(options), density_options_(options.density) {
   const scene::CameraPose at = scene.camera ? scene.camera->pose : scene::default_pose(mosaic_);
   scene::require_near(mosaic_, at.lat, at.lon);
   require_x_display();
@@ -280,8 +281,13 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   stats.objects_ms = ms_since(t0);
   stats.objects_merged = objects_.figures().remerged;
   t0 = Clock::now();
-  scene_->tree().traverse(camera_, traversal, frame_);
+  boxes_.clear();
+  volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+  stats.density_ms = ms_since(t0);
+  t0 = Clock::now();
+  scene_->tree().traverse(camera_, traversal, frame_, boxes_);
   stats.traversal_ms = ms_since(t0);
+  stats.boxes = frame_.boxes;
   t0 = Clock::now();
   sync_vertices(*renderer_);  // the low alternatives the traversal built appended vertices
   renderer_->set_frame(frame_);
@@ -289,6 +295,8 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   stats.triangles = frame_.indices.size() / 3;
   stats.merged_triangles = static_cast<std::size_t>(
       std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kMergedLevel)));
+  stats.box_triangles = static_cast<std::size_t>(
+      std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kBoxLevel)));
   stats.nodes_visited = frame_.nodes_visited;
   return stats;
 }
