@@ -33,7 +33,7 @@ struct BenchOptions {
   std::vector<std::filesystem::path> dems;
   std::filesystem::path under_test;
   std::string exactness_views;
-  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects,lowalt,density";
+  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects,lowalt,aa,density";
   int views = 0, repeats = 0, frames = 0;
 };
 
@@ -85,13 +85,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects", "lowalt", "density"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects", "lowalt", "aa", "density"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build, exactness, rf, objects, lowalt, density)");
+                               "' (terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa, density)");
     }
     out.insert(s);
   }
@@ -188,6 +188,13 @@ void run_bench(const BenchOptions& o, const std::string& command) {
         c.log("exactness: no scene for " + t.name + " (only the shared N44W072 and Utah terrains have one)");
       }
     }
+  if (suites.count("aa")) {
+    if (real.empty()) {
+      c.log("aa: no terrain (give --data or --dem): skipped");
+    } else {
+      results["aa"] = aa_suite(c, real.front(), transmitters.empty() ? std::vector<volume::Transmitter>{} : transmitters.front());
+    }
+  }
   if (suites.count("objects")) {
     const std::filesystem::path models = "/usr/share/assimp/models";
     const auto truck = models / "glTF/CesiumMilkTruck/CesiumMilkTruck.gltf", wuson = models / "PLY/Wuson.ply";
@@ -253,7 +260,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects, lowalt, density")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa, density")->capture_default_str();
   cmd->add_option("--under-test", o->under_test,
                   "The terravol executable whose render the exactness suite measures (default: this one)")
       ->check(CLI::ExistingFile);

@@ -123,7 +123,26 @@ nlohmann::json object_suite(const BenchConfig& config, const Terrain& terrain, c
 // whether each image equals the unculled one. Throws what SceneRenderer throws.
 nlohmann::json lowalt_suite(const BenchConfig& config, const Terrain& terrain);
 
-// 11. Densities (issue 15; bench/density_suite.cpp), over the bundled DEM (N45E006, made by
+// 11. Antialiasing (issue 14): the coverage-mask tiler (tiler/, app/render/tiled_renderer.h)
+// against VTK's box-filtered supersampling (`fly --samples`: the frame drawn f times larger and
+// averaged down), each image against a 16 x 16-sample reference (the same frame drawn by VTK 16
+// times larger, in tiles of at most 4096 samples a side through off-centre projections, and
+// averaged down). Side by side per view (after an untimed warm-up, `repeats` times, medians):
+// first the terrain at the configured size over `volume_views` views of the terrain
+// flythrough, drawn as `terravol render` draws (sky gradient, 60 km haze): VTK at 1, 4, 16 and 64
+// samples, the tiler at aa 1, 2, 4 and 8 (its front-to-back traversal included), and the tiler
+// at 8 with the tree's occlusion pass at sample resolution (tiled_traversal; its image must be
+// the same); then, given transmitters, the three-volume scene (three_volume_scene) at 1920x1080
+// over max(1, volume_views / 2) views of its orbit: VTK at 1 and 16 samples, the tiler at 4 and 8.
+// A VTK frame's time is the back-to-front traversal, the upload of the triangle list, the draw,
+// the read-back and the filter (what `fly --samples` does per frame), all from one traversal
+// (the LOD choice at f times the size and f times the threshold is the same). Per view: frame
+// times, PSNR against the reference, the tiler at 8 against VTK at 16 samples, the issue's
+// ratios, the tiler's work per pixel (pyramid cells visited, fragments, shading points). The
+// first view's images go to out/aa/. Throws what SceneRenderer throws.
+nlohmann::json aa_suite(const BenchConfig& config, const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters);
+
+// 12. Densities (issue 15; bench/density_suite.cpp), over the bundled DEM (N45E006, made by
 // `terravol sample-dem`; its default transmitter at 45.5 N, 6.5 E, 30 m): a 6 km path-loss
 // volume (6", 0-2000 m every 100 m) and the same refined 2x and 4x per axis, each seen from
 // 1.75, 3.5, 7 and 14 volume radii (from the south-west, 30 degrees up): per view, side by side,

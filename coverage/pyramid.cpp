@@ -364,6 +364,8 @@ bool Pyramid::all_full(int level, int cx0, int cx1, int cy0, int cy1) {
   std::uint64_t& t = tile(tx, ty);
   const std::uint64_t nw = mask & ~t;
   if (!nw) return;
+  if (record_) report(tx, ty, nw);
+  if (!claim_) return;
   const bool was_empty = t == 0;
   t |= nw;
   stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
@@ -388,7 +390,7 @@ void Pyramid::propagate(int level, int cx, int cy) {
   }
 }
 
-// Marks a vacant element and everything below it wholly covered.
+// Marks a vacant element and everything below it wholly covered (cover_cell reports it).
 void Pyramid::fill(int level, int cx, int cy) {
   if (level == 0) {
     tile(cx, cy) = kAll;
@@ -406,6 +408,13 @@ void Pyramid::fill(int level, int cx, int cy) {
   }
   for (int j = 0; j < 8; ++j)
     for (int i = 0; i < 8; ++i) fill(level - 1, 8 * cx + i, 8 * cy + j);
+}
+
+// Reports every pixel of a (formerly) vacant element to record_: its tiles row by row, each row
+// one run (a vacant element has every child, since missing children count as covered).
+void Pyramid::report_subtree(int level, int cx, int cy) {
+  const int side = 1 << (3 * level);  // tiles per side
+  for (int j = 0; j < side; ++j) record_->push_back({cx * side, cy * side + j, kAll, side});
 }
 
 namespace {
@@ -452,12 +461,15 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
   Cell& m = cell(level, cx, cy);
   const std::uint64_t w = m.v & pc;
   if (w) {
-    m.c |= w;
-    m.v &= ~w;
-    stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(w)) * static_cast<std::uint64_t>(s * s);
+    if (claim_) {
+      m.c |= w;
+      m.v &= ~w;
+      stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(w)) * static_cast<std::uint64_t>(s * s);
+    }
     for (std::uint64_t bits = w; bits; bits &= bits - 1) {
       const int bit = std::countr_zero(bits);
-      fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+      if (claim_) fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+      if (record_) report_subtree(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
     }
   }
   for (std::uint64_t active = ~(w | pv | m.c); active; active &= active - 1) {
@@ -469,12 +481,15 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
       std::uint64_t& t = tile(x, y);
       const std::uint64_t nw = tile_mask(E, act.data(), n, static_cast<i64>(x) * 8, static_cast<i64>(y) * 8, 0, 7) & ~t;
       if (!nw) continue;
+      if (record_) report(x, y, nw);
+      if (!claim_) continue;
       t |= nw;
       stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(nw));
       m.v &= ~b;
       if (t == kAll) m.c |= b;
     } else {
       cover_cell(level - 1, x, y, E, act.data(), n);
+      if (!claim_) continue;
       const Cell& ch = cell(level - 1, x, y);
       if (ch.c == kAll) m.c |= b;
       if (ch.v != kAll) m.v &= ~b;
@@ -600,7 +615,31 @@ void check_arguments(const char* function, const char* distance, double px, std:
 
 }  // namespace
 
-void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) {
+void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px) { cover_polygon(polygon, margin_px); }
+
+void Pyramid::cover(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& claimed) {
+  record(polygon, margin_px, claimed, true);
+}
+
+void Pyramid::vacant(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& out) {
+  record(polygon, margin_px, out, false);
+}
+
+void Pyramid::record(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& to, bool claim) {
+  record_ = &to;
+  claim_ = claim;
+  try {
+    cover_polygon(polygon, margin_px);
+  } catch (...) {
+    record_ = nullptr;
+    claim_ = true;
+    throw;
+  }
+  record_ = nullptr;
+  claim_ = true;
+}
+
+void Pyramid::cover_polygon(std::span<const glm::dvec2> polygon, double margin_px) {
   check_arguments("cover", "margin", margin_px, polygon.size());
   ++stats_.cover_calls;
   const int nv = static_cast<int>(polygon.size());
@@ -681,7 +720,7 @@ void Pyramid::cover_general(const detail::FixedPoint* p, int nv, i64 margin, int
     for (int cx = cx0; cx <= cx1; ++cx) {
       if (is_full(k, cx, cy)) continue;
       cover_cell(k, cx, cy, E, E.all.data(), E.n);
-      propagate(k, cx, cy);
+      if (claim_) propagate(k, cx, cy);
     }
   }
 }

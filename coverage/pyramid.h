@@ -53,6 +53,15 @@ inline constexpr double kMaxCoordinate = 16777216.0;  // 2^24 px: |x| and |y| of
 inline constexpr double kMaxMargin = 256.0;    // px: margin and dilation are in [0, kMaxMargin]
 inline constexpr int kMaxVertices = 64;        // vertices of one polygon
 
+// Pixels of `run` finest tiles in a row, (tx, ty) to (tx + run - 1, ty), each with the same
+// mask: bit (y % 8) * 8 + x % 8 of tile (x / 8, y / 8). Runs longer than 1 have every pixel
+// (a whole cell the polygon covers, reported row by row).
+struct TileMask {
+  int tx = 0, ty = 0;
+  std::uint64_t mask = 0;
+  int run = 1;
+};
+
 // Not thread-safe (hidden() counts into the stats too): one pyramid per thread.
 class Pyramid {
  public:
@@ -86,6 +95,21 @@ class Pyramid {
   // more than kMaxVertices vertices.
   void cover(std::span<const glm::dvec2> polygon, double margin_px);
 
+  // cover(), and every pixel it newly covers appended to `claimed` (not cleared first), tile by
+  // tile or in runs of whole tiles: for the renderer that shades what each polygon claims
+  // (Greene, section 3.1: the W masks, down to the finest level; a triage W bit, a whole cell,
+  // comes as one run per row of its tiles). A tile may appear more than once with disjoint
+  // masks; every mask is non-zero; no pixel is reported twice between two clear()s, and the
+  // union of the masks is exactly the set of pixels the call covered. Same contract and throws
+  // as cover().
+  void cover(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& claimed);
+
+  // The pixels cover(polygon, margin_px) would claim now (those of the polygon still vacant),
+  // appended to `out` tile by tile as cover() above reports them, without covering them: a
+  // translucent polygon shows over exactly these. The pyramid is not changed (its stats count
+  // the call as a cover call and its cells as visited). Same contract and throws as cover().
+  void vacant(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& out);
+
   // Test-only tiling (section 5.2): true only when every pixel of the viewport whose centre
   // lies within dilation_px of the polygon (inside it, or outside at a Euclidean distance
   // <= dilation_px, so the corners are rounded) is covered. The polygon taken is the convex
@@ -100,6 +124,9 @@ class Pyramid {
 
   // Whether pixel (x, y) is covered (0 <= x < width, 0 <= y < height; false outside).
   bool covered(int x, int y) const;
+  // The covered pixels of finest tile (tx, ty), 0 <= tx < grid_width(0), 0 <= ty <
+  // grid_height(0) (unchecked): bit (y % 8) * 8 + x % 8; pixels beyond the viewport are set.
+  std::uint64_t tile_bits(int tx, int ty) const { return tile(tx, ty); }
   // The number of covered pixels in the viewport.
   std::uint64_t covered_count() const;
 
@@ -152,6 +179,10 @@ class Pyramid {
   template <int N>
   void cover_small(const detail::FixedPoint* p, std::int64_t margin, int x0, int x1, int y0, int y1);
   void cover_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
+  void cover_polygon(std::span<const glm::dvec2> polygon, double margin_px);
+  void record(std::span<const glm::dvec2> polygon, double margin_px, std::vector<TileMask>& to, bool claim);
+  void report(int tx, int ty, std::uint64_t mask) { record_->push_back({tx, ty, mask, 1}); }
+  void report_subtree(int level, int cx, int cy);
   bool hidden_cell(int level, int cx, int cy, const Edges& edges, const std::uint8_t* act, int n);
   bool hidden_tile(int tx, int ty, const Edges& edges, const std::uint8_t* act, int n, int j0, int j1);
 
@@ -160,6 +191,10 @@ class Pyramid {
   std::vector<Level> levels_;         // [0] the tile grid (no cells), then the triage levels
   std::vector<Cell> cleared_;         // every triage level's cells when empty, in order
   Stats stats_;
+  // While cover(..., claimed) or vacant() runs: where the pixels go, and whether they are
+  // covered (false: vacant(), which only reports them).
+  std::vector<TileMask>* record_ = nullptr;
+  bool claim_ = true;
 };
 
 }  // namespace terravol::coverage

@@ -44,6 +44,10 @@ float separation_height(const TerrainTree::Impl& m, int level, int ci, int cj);
 
 // One traversal's boxes, distributed. Items of a bucket keep the order the boxes were given in.
 struct BoxScratch {
+  struct OutsideBoxes {  // a place beyond a window side without an outside slot, and its bucket
+    int band, column;
+    std::int32_t bucket;
+  };
   struct Part {  // a box, or the piece of one inside a region of the tree
     glm::vec3 lo, hi;
     std::uint32_t box;    // index into the boxes given
@@ -86,6 +90,8 @@ struct BoxScratch {
   };
   std::vector<Item> bsp_stack_;
   std::vector<Poly3> poly_pool_;
+  std::array<std::vector<OutsideBoxes>, 4> outside_places_;
+  std::unordered_map<std::uint32_t, std::int32_t> outside_slot_;  // outside slot key -> slot
   glm::dvec3 eye_{0.0};
   BoxStats stats;
   bool active = false;
@@ -98,7 +104,10 @@ struct BoxScratch {
   // Buckets the walk asks for (-1: none). `level_index` is level + top, as the walk packs it.
   std::int32_t whole(int level_index, int ci, int cj) const;  // a cell not entered: all of its column
   std::int32_t above(int level_index, int ci, int cj) const;  // above its separation height (no slot there)
-  std::int32_t outside(int side) const;                       // beyond a window side without an outside slot
+  // Beyond a window side, in the places (band, column: mrbsp/tree_impl.h, "kOutside") that have
+  // no outside slot: one bucket each, for the walk to draw where such a slot would be. (Boxes
+  // in a place with a slot go into its small BSP.)
+  const std::vector<OutsideBoxes>& outside_places(int side) const { return outside_places_[static_cast<std::size_t>(side)]; }
   bool leaf(int level_index, int ci, int cj) const;           // in a drawn cell without a low slot
   bool in_slot(std::int32_t slot) const {
     return slot >= 0 && static_cast<std::size_t>(slot) < slot_boxed.size() && slot_boxed[static_cast<std::size_t>(slot)];
@@ -126,6 +135,9 @@ struct BoxScratch {
   void insert_into_slot(const TerrainTree::Impl& m, std::int32_t slot, const Part& p, double tol);
   void emit_part(const Part& p, const glm::dvec3& eye, Frame& frame);
   void emit_poly(const Poly& p, Frame& frame);
+  // A part beyond window side `side` cut into that side's bands and (south, north) level-0
+  // columns as the merge cuts pieces (merge.cpp, to_bands): into the place's slot, else its bucket.
+  void to_outside(const TerrainTree::Impl& m, int side, const Part& p, double tol);
 };
 
 }  // namespace terravol::mrbsp

@@ -217,8 +217,52 @@ std::int32_t BoxScratch::whole(int level_index, int ci, int cj) const {
 std::int32_t BoxScratch::above(int level_index, int ci, int cj) const {
   return active ? find(cell_key(kKeyAbove, level_index, ci, cj)) : -1;
 }
-std::int32_t BoxScratch::outside(int side) const {
-  return active ? find(kKeyOutside << 61 | static_cast<std::uint64_t>(side)) : -1;
+void BoxScratch::to_outside(const TerrainTree::Impl& m, int side, const Part& p, double tol) {
+  const int axis = side < 2 ? 0 : 1;
+  const bool low_side = side % 2 == 0;  // west and south lie below their planes
+  const auto to_place = [&](int band, int column, const Part& q) {
+    const SlotKey key = outside_key(side, band, column);
+    if (const auto it = outside_slot_.find(key); it != outside_slot_.end()) {
+      insert_into_slot(m, it->second, q, tol);
+      return;
+    }
+    const std::uint64_t bucket_key = kKeyOutside << 61 | static_cast<std::uint64_t>(side) << 40 |
+                                     static_cast<std::uint64_t>(band) << 20 | static_cast<std::uint64_t>(column);
+    const bool fresh = find(bucket_key) < 0;
+    add_part(bucket_key, q);
+    if (fresh) outside_places_[static_cast<std::size_t>(side)].push_back({band, column, find(bucket_key)});
+  };
+  const auto to_columns = [&](int band, Part q) {
+    const int columns = side < 2 ? 1 : m.cells_at(0), s0 = m.cell_size(0);
+    for (int column = 0; column + 1 < columns; ++column) {
+      Part west{}, east{};
+      const int c = cut(q, 0, m.xs[static_cast<std::size_t>((column + 1) * s0)], tol, west, east);
+      if (c < 0) {
+        to_place(band, column, q);
+        return;
+      }
+      if (c == 0) {
+        to_place(band, column, west);
+        q = east;
+      }
+    }
+    to_place(band, columns - 1, q);
+  };
+  Part q = p;
+  for (int band = 0; band + 1 < kBands; ++band) {
+    Part below{}, above{};
+    const int c = cut(q, axis, m.band_plane(side, band + 1), tol, below, above);
+    const int near = low_side ? 1 : -1;  // the window's side of the band plane
+    if (c == near) {
+      to_columns(band, q);
+      return;
+    }
+    if (c == 0) {
+      to_columns(band, low_side ? above : below);
+      q = low_side ? below : above;
+    }
+  }
+  to_columns(kBands - 1, q);
 }
 bool BoxScratch::leaf(int level_index, int ci, int cj) const {
   return active && (find(cell_key(kKeyLeaf, level_index, ci, cj, 0)) >= 0 || find(cell_key(kKeyLeaf, level_index, ci, cj, 1)) >= 0);
@@ -321,6 +365,10 @@ void BoxScratch::distribute(TerrainTree::Impl& m, const Camera& camera, const De
   stats.boxes = given.size();
   active = true;
   eye_ = camera.eye;
+  for (auto& places : outside_places_) places.clear();
+  outside_slot_.clear();
+  for (const auto& slots : m.outside)
+    for (const std::int32_t slot : slots) outside_slot_.emplace(m.slots[static_cast<std::size_t>(slot)].key, slot);
   const double tol = window_tolerance(m);
   const double wx0 = m.xs.front(), wx1 = m.xs.back(), wy0 = m.ys.front(), wy1 = m.ys.back();
   constexpr std::uint32_t kDrawnState = 1;
@@ -395,11 +443,8 @@ void BoxScratch::distribute(TerrainTree::Impl& m, const Camera& camera, const De
       Part lo_part{}, hi_part{};
       const int c = cut(p, a, bounds[side], tol, lo_part, hi_part);
       const bool beyond_is_low = side % 2 == 0;
-      // Beyond the side: into its outside slot's small BSP, else into the side's bucket.
-      const auto beyond = [&](const Part& q) {
-        if (m.outside[side] >= 0) insert_into_slot(m, m.outside[side], q, tol);
-        else add_part(kKeyOutside << 61 | static_cast<std::uint64_t>(side), q);
-      };
+      // Beyond the side: into its bands' small BSPs or buckets (to_outside).
+      const auto beyond = [&](const Part& q) { to_outside(m, side, q, tol); };
       if (c == 0) {
         beyond(beyond_is_low ? lo_part : hi_part);
         p = beyond_is_low ? hi_part : lo_part;

@@ -24,6 +24,7 @@
 //     planes.
 // Classification is in double precision, with a tolerance relative to the window's size.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -31,6 +32,7 @@
 #include <span>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -142,6 +144,7 @@ glm::u8vec4 mix_color(glm::u8vec4 a, glm::u8vec4 b, double t) {
 
 // --- Distribution: one surface through the tree's planes --------------------------------------
 
+
 class Distributor {
  public:
   Distributor(const TerrainTree::Impl& m, SurfacePieces& s) : m_(m), s_(s) {
@@ -151,7 +154,7 @@ class Distributor {
 
   // Every triangle anew.
   void run() {
-    s_.pieces.clear();
+    gathered_.clear();
     s_.refs.clear();
     s_.vertices.resize(s_.input_vertices);
     s_.colors.resize(s_.input_vertices);
@@ -162,11 +165,16 @@ class Distributor {
   }
 
   // After a slide (Impl::shift_merged): the pieces the surface has are those inside `kept`,
-  // the lattice rectangle of the window that was already in the old one; the triangles
-  // reaching beyond it are sent through the tree again, and what comes to a region inside it
-  // is left out (its pieces are there already).
-  void run_outside(const TerrainTree::Impl::Region& kept) {
+  // the lattice rectangle of the window that was already in the old one, and those of the
+  // outside places that lie where places lay before (`kept_places`, their keys); the triangles reaching beyond
+  // the rectangle are sent through the tree again, and what comes to a region inside it, or to
+  // a kept band, is left out (its pieces are there already).
+  // `renamed` holds the kept pieces (into the surface's refs).
+  void run_outside(const TerrainTree::Impl::Region& kept, const std::unordered_set<SlotKey>& kept_places,
+                   std::vector<SurfacePieces::Piece> renamed) {
+    gathered_ = std::move(renamed);
     kept_ = kept;
+    kept_places_ = kept_places;
     skip_kept_ = true;
     const glm::dvec2 lo(m_.xs[static_cast<std::size_t>(kept.i0)], m_.ys[static_cast<std::size_t>(kept.j0)]);
     const glm::dvec2 hi(m_.xs[static_cast<std::size_t>(kept.i1)], m_.ys[static_cast<std::size_t>(kept.j1)]);
@@ -195,15 +203,12 @@ class Distributor {
     }
   }
 
-  // Sorts the pieces by slot (stable: in the order they came) and fits the storage.
+  // Keeps the pieces by slot (stable: in the order they came) and fits the storage.
   void finish() {
-    std::stable_sort(s_.pieces.begin(), s_.pieces.end(),
-                     [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
+    s_.keep(gathered_);
     s_.vertices.shrink_to_fit();
     s_.colors.shrink_to_fit();
     s_.tcoords.shrink_to_fit();
-    s_.pieces.shrink_to_fit();
-    s_.refs.shrink_to_fit();
   }
 
   // What to do with a polygon (pool_[first .. first + count)): kChain: the window's boundary
@@ -293,8 +298,58 @@ class Distributor {
   }
 
   void arrive(SlotKey slot, std::uint32_t first, std::uint32_t count) {
-    s_.pieces.push_back({slot, static_cast<std::uint32_t>(s_.refs.size()), count});
+    gathered_.push_back({slot, static_cast<std::uint32_t>(s_.refs.size()), count});
     s_.refs.insert(s_.refs.end(), pool_.begin() + first, pool_.begin() + first + count);
+  }
+
+  // What lies beyond boundary plane `side`, cut into that side's bands (the band planes are
+  // parallel to it; a piece in a band plane goes with the band nearer the window). A kept
+  // band's pieces are there already (run_outside).
+  void to_bands(int side, std::uint32_t first, std::uint32_t count) {
+    const int axis = side < 2 ? 0 : 1;
+    const bool low_side = side % 2 == 0;  // west and south lie below their planes
+    for (int band = 0; band < kBands; ++band) {
+      std::uint32_t near_first = first, near_count = count, far_count = 0, far_first = 0;
+      if (band + 1 < kBands) {
+        const Parts p = split_axis(first, count, axis, m_.band_plane(side, band + 1), band_plane_id(side, band));
+        // split_axis gives a piece lying in the plane to the back: for west and south that is
+        // beyond, so it is moved to the near side here.
+        const bool in_plane = p.coplanar;
+        near_first = low_side ? (in_plane ? p.back_first : p.front_first) : p.back_first;
+        near_count = low_side ? (in_plane ? p.back_count : p.front_count) : p.back_count;
+        far_first = low_side ? p.back_first : p.front_first;
+        far_count = low_side ? (in_plane ? 0 : p.back_count) : p.front_count;
+      }
+      if (near_count >= 3) to_columns(side, band, near_first, near_count);
+      if (far_count < 3) return;
+      first = far_first;
+      count = far_count;
+    }
+  }
+  // A south or north band's part cut into the window's level-0 columns (west and east bands
+  // are one column); a kept place's pieces are there already (run_outside).
+  void to_columns(int side, int band, std::uint32_t first, std::uint32_t count) {
+    const int columns = side < 2 ? 1 : m_.cells_at(0), s0 = m_.cell_size(0);
+    for (int column = 0; column < columns; ++column) {
+      std::uint32_t in_first = first, in_count = count;
+      bool rest = false;
+      if (column + 1 < columns) {
+        const int i = (column + 1) * s0;
+        const Parts p = split_axis(first, count, 0, m_.xs[static_cast<std::size_t>(i)], x_plane(i));
+        in_first = p.back_first;  // west of the line (a piece in it goes west)
+        in_count = p.back_count;
+        first = p.front_first;
+        count = p.front_count;
+        rest = count >= 3;
+      }
+      if (in_count >= 3 && !(skip_kept_ && kept_places_.count(outside_key(side, band, column)))) {
+        arrive(outside_key(side, band, column), in_first, in_count);
+      }
+      if (!rest) return;
+    }
+  }
+  std::uint32_t band_plane_id(int side, int band) const {
+    return static_cast<std::uint32_t>(2 * (m_.n + 1)) + m_.total_cells + static_cast<std::uint32_t>(side * kBands + band);
   }
 
   std::uint32_t x_plane(int i) const { return static_cast<std::uint32_t>(i); }
@@ -322,7 +377,7 @@ class Distributor {
       const std::uint32_t out_count = low_side ? p.back_count : p.front_count;
       const std::uint32_t in_first = low_side ? p.front_first : p.back_first;
       const std::uint32_t in_count = low_side ? p.front_count : p.back_count;
-      if (out_count >= 3) arrive(kOutsideKey0 + w.stage, out_first, out_count);
+      if (out_count >= 3) to_bands(w.stage, out_first, out_count);
       if (in_count >= 3) stack_.push_back({kChain, static_cast<std::uint8_t>(w.stage + 1), 0, 0, 0, 0, in_first, in_count});
       return;
     }
@@ -376,9 +431,11 @@ class Distributor {
 
   const TerrainTree::Impl& m_;
   SurfacePieces& s_;
+  std::vector<SurfacePieces::Piece> gathered_;  // kept by finish()
   double eps_ = 0.0;
   bool skip_kept_ = false;
   TerrainTree::Impl::Region kept_;
+  std::unordered_set<SlotKey> kept_places_;
   std::vector<std::uint32_t> pool_, back_, front_;
   std::vector<Work> stack_;
   EdgeCache cache_;
@@ -621,9 +678,10 @@ class SlotBuilder {
   // samples 1.44x, over 1,000 1.37x; 64 candidates over all of them 1.32x). So the samples are
   // many, and each is cheap: its bounding sphere decides its side unless the plane passes
   // through the sphere, and a candidate stops being counted once its spans alone score worse
-  // than the best so far. 12 candidates over 256 samples: hydrogen 1.45x, the benchmark scene
-  // 2.05x, for about 1.4x the merge time of 6 over 40 (1.73x and 2.18x); 16 over 512 store
-  // 1.6% fewer pieces for 10% more time.
+  // than the best so far. The candidates are screened on 32 of the samples first, and the 3
+  // best scored on all of them. 16 candidates over 512 samples so: hydrogen 1.47x, the
+  // benchmark scene 2.03x, the merge 1.3-1.4x the time of 6 candidates over 40 unscreened
+  // (1.73x and 2.18x); 12 over 256: 1.51x and 2.06x, 1.15x the time.
   // Besides the polygons' own planes, vertical planes through the edges of nearly horizontal
   // polygons are candidates: a surface over the ground such as an agl slice is a height field
   // on the volume's lattice, and the vertical planes through its edges order it as the
@@ -632,9 +690,45 @@ class SlotBuilder {
   // then stores 1.25x its input (1.77x without), everything 2.01x (2.37x); hydrogen.vtk's
   // closed surface 1.43x (1.37x: for a blob these planes win locally and cost more below; for
   // steeper polygons they are not tried).
+  // The score of a splitter (kW per span plus the imbalance) over every stride-th of the
+  // samples choose() packed; infinity once it cannot be below `cutoff`.
+  double score(const PlaneD& plane, std::uint32_t samples, std::uint32_t stride, double cutoff) const {
+    constexpr double kW = 8.0;  // a span costs as much as this much imbalance
+    const glm::vec3 n(plane.n);
+    const auto d = static_cast<float>(plane.d + glm::dot(plane.n, origin_));
+    // Sides by sphere first (a loop without branches), then the polygons whose sphere the
+    // plane passes through, exactly.
+    int front = 0, back = 0, counted = 0;
+    for (std::uint32_t k = 0; k < samples; k += stride) {
+      const glm::vec4& sp = sample_spheres_[k];
+      const float dist = n.x * sp.x + n.y * sp.y + n.z * sp.z + d;
+      front += dist > sp.w;
+      back += dist < -sp.w;
+      ++counted;
+    }
+    // The polygons the plane passes through the spheres of can lessen the imbalance by at
+    // most their number: a candidate that cannot win even so is not looked at further.
+    const int straddling = counted - front - back;
+    if (std::abs(front - back) - straddling >= cutoff) return std::numeric_limits<double>::infinity();
+    int spans = 0;
+    for (std::uint32_t k = 0; k < samples; k += stride) {
+      const glm::vec4& sp = sample_spheres_[k];
+      const float dist = n.x * sp.x + n.y * sp.y + n.z * sp.z + d;
+      if (dist > sp.w || dist < -sp.w) continue;
+      switch (classify(polys_[sample_polys_[k]], plane)) {
+        case Side::kSpanning:
+          if (kW * ++spans >= cutoff) return std::numeric_limits<double>::infinity();
+          break;
+        case Side::kFront: ++front; break;
+        case Side::kBack: ++back; break;
+        case Side::kCoplanar: break;
+      }
+    }
+    return kW * spans + std::abs(front - back);
+  }
+
   bool choose(std::uint32_t begin, std::uint32_t end, PlaneD& best) {
-    constexpr std::uint32_t kCandidates = 12, kSamples = 256;
-    constexpr double kW = 8.0;     // a span costs as much as this much imbalance
+    constexpr std::uint32_t kCandidates = 16, kSamples = 512;
     constexpr double kFlat = 0.8;  // |n.z| of a polygon whose edge's vertical plane is a candidate
     const std::uint32_t size = end - begin;
     const std::uint32_t candidates = std::min(size, size <= 4 ? 2u : kCandidates), samples = std::min(size, kSamples);
@@ -648,81 +742,68 @@ class SlotBuilder {
       sample_spheres_.push_back(glm::vec4(glm::vec3(p.centre - origin_), static_cast<float>(p.radius + eps_)));
       sample_polys_.push_back(q);
     }
-    double best_score = std::numeric_limits<double>::max();
-    bool found = false;
     // Candidates 0 .. candidates-1: the polygons' own planes; then, for every second of those
     // polygons that lies within about 37 degrees of horizontal, the vertical plane through its
     // longest edge.
+    candidate_planes_.clear();
     for (std::uint32_t c = 0; c < candidates + candidates / 2; ++c) {
       const bool vertical = c >= candidates;
       const std::uint32_t which = vertical ? 2 * (c - candidates) + 1 : c;
       const Poly& candidate = polys_[list_[begin + static_cast<std::uint32_t>(static_cast<std::uint64_t>(which) * size / candidates)]];
       if (!candidate.flat) continue;
-      if (vertical && std::abs(candidate.plane.n.z) < kFlat) continue;
+      if (!vertical) {
+        candidate_planes_.push_back({candidate.plane, false});
+        continue;
+      }
+      if (std::abs(candidate.plane.n.z) < kFlat) continue;
       PlaneD vplane;
-      if (vertical) {
-        double best_len = 0;
-        for (std::uint32_t k = 0; k < candidate.count; ++k) {
-          const glm::dvec3 a = pos(ids_[candidate.first + k]), b = pos(ids_[candidate.first + (k + 1) % candidate.count]);
-          const glm::dvec2 e(b.x - a.x, b.y - a.y);
-          const double len = glm::length(e);
-          if (len > best_len) {
-            best_len = len;
-            vplane.n = glm::dvec3(-e.y / len, e.x / len, 0.0);
-            vplane.d = -glm::dot(vplane.n, a);
-          }
-        }
-        if (!(best_len > 1e-6)) continue;
-      }
-      const PlaneD& plane = vertical ? vplane : candidate.plane;
-      const glm::vec3 n(plane.n);
-      const auto d = static_cast<float>(plane.d + glm::dot(plane.n, origin_));
-      // Sides by sphere first (a loop without branches), then the polygons whose sphere the
-      // plane passes through, exactly.
-      int front = 0, back = 0;
-      for (const glm::vec4& sp : sample_spheres_) {
-        const float dist = n.x * sp.x + n.y * sp.y + n.z * sp.z + d;
-        front += dist > sp.w;
-        back += dist < -sp.w;
-      }
-      // The polygons the plane passes through the spheres of can lessen the imbalance by at
-      // most their number: a candidate that cannot win even so is not looked at further.
-      const int straddling = static_cast<int>(samples) - front - back;
-      if (std::abs(front - back) - straddling >= best_score) continue;
-      int spans = 0;
-      bool worse = false;
-      for (std::uint32_t k = 0; k < samples && !worse; ++k) {
-        const glm::vec4& sp = sample_spheres_[k];
-        const float dist = n.x * sp.x + n.y * sp.y + n.z * sp.z + d;
-        if (dist > sp.w || dist < -sp.w) continue;
-        switch (classify(polys_[sample_polys_[k]], plane)) {
-          case Side::kSpanning:
-            ++spans;
-            worse = kW * spans >= best_score;
-            break;
-          case Side::kFront: ++front; break;
-          case Side::kBack: ++back; break;
-          case Side::kCoplanar: break;
+      double best_len = 0;
+      for (std::uint32_t k = 0; k < candidate.count; ++k) {
+        const glm::dvec3 a = pos(ids_[candidate.first + k]), b = pos(ids_[candidate.first + (k + 1) % candidate.count]);
+        const glm::dvec2 e(b.x - a.x, b.y - a.y);
+        const double len = glm::length(e);
+        if (len > best_len) {
+          best_len = len;
+          vplane.n = glm::dvec3(-e.y / len, e.x / len, 0.0);
+          vplane.d = -glm::dot(vplane.n, a);
         }
       }
-      if (worse) continue;
-      if (vertical) {
+      if (best_len > 1e-6) candidate_planes_.push_back({vplane, true});
+    }
+    // Each candidate is scored first on every stride-th sample, and only the few best then on
+    // all of them: about a third of the work, for the same choice nearly always.
+    constexpr std::uint32_t kScreen = 32, kFinalists = 3;
+    const std::uint32_t stride = samples > 2 * kScreen ? samples / kScreen : 1;
+    if (stride > 1 && candidate_planes_.size() > kFinalists) {
+      std::vector<std::pair<double, std::size_t>>& ranked = ranked_;
+      ranked.clear();
+      for (std::size_t c = 0; c < candidate_planes_.size(); ++c) {
+        ranked.push_back({score(candidate_planes_[c].plane, samples, stride, std::numeric_limits<double>::max()), c});
+      }
+      std::partial_sort(ranked.begin(), ranked.begin() + kFinalists, ranked.end());
+      std::vector<Candidate> finalists;
+      for (std::uint32_t k = 0; k < kFinalists; ++k) finalists.push_back(candidate_planes_[ranked[k].second]);
+      candidate_planes_ = std::move(finalists);
+    }
+    double best_score = std::numeric_limits<double>::max();
+    bool found = false;
+    for (const Candidate& candidate : candidate_planes_) {
+      const double s = score(candidate.plane, samples, 1, best_score);
+      if (!(s < best_score)) continue;
+      if (candidate.vertical) {
         // A plane through no polygon removes none: it must leave polygons on both sides, found
         // exactly, so that each side is smaller than the range.
         bool has_front = false, has_back = false;
         for (std::uint32_t k = 0; k < samples && !(has_front && has_back); ++k) {
-          const Side side = classify(polys_[sample_polys_[k]], plane);
+          const Side side = classify(polys_[sample_polys_[k]], candidate.plane);
           has_front |= side == Side::kFront;
           has_back |= side == Side::kBack;
         }
         if (!has_front || !has_back) continue;
       }
-      const double score = kW * spans + std::abs(front - back);
-      if (score < best_score) {
-        best_score = score;
-        best = plane;
-        found = true;
-      }
+      best_score = s;
+      best = candidate.plane;
+      found = true;
     }
     if (found) return true;
     for (std::uint32_t k = begin; k < end; ++k) {
@@ -834,10 +915,12 @@ class SlotBuilder {
           std::uint32_t v = ids_[p.first + k];
           if (!(v & kTerrainRef)) {
             if (remap[v] == std::numeric_limits<std::uint32_t>::max()) {
-              remap[v] = static_cast<std::uint32_t>(out_.positions.size());
-              out_.positions.emplace_back(pos_[v]);
-              out_.colors.push_back(col_[v]);
-              if (m_.has_tcoords) out_.tcoords.push_back(tc_[v]);
+              if (!out_.staged) out_.staged = std::make_unique<StagedVertices>();
+              StagedVertices& staged = *out_.staged;
+              remap[v] = static_cast<std::uint32_t>(staged.positions.size());
+              staged.positions.emplace_back(pos_[v]);
+              staged.colors.push_back(col_[v]);
+              if (m_.has_tcoords) staged.tcoords.push_back(tc_[v]);
               out_.top = std::max(out_.top, static_cast<float>(pos_[v].z));
             }
             v = remap[v];
@@ -869,6 +952,12 @@ class SlotBuilder {
   EdgeCache cache_;
   std::size_t dropped_ = 0;
   glm::dvec3 origin_{0.0};  // the window's centre: the samples' spheres are relative to it
+  struct Candidate {
+    PlaneD plane;
+    bool vertical;  // through no polygon (choose())
+  };
+  std::vector<Candidate> candidate_planes_;
+  std::vector<std::pair<double, std::size_t>> ranked_;
   std::vector<glm::vec4> sample_spheres_;  // choose(): centre, radius plus the tolerance
   std::vector<std::uint32_t> sample_polys_;
 };
@@ -891,13 +980,6 @@ void release(std::vector<T>& v) {
 }
 
 bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
-
-// The pieces of surface `s` that arrived at slot `key`.
-std::pair<const SurfacePieces::Piece*, const SurfacePieces::Piece*> arrivals(const SurfacePieces& s, SlotKey key) {
-  const auto range = std::equal_range(s.pieces.begin(), s.pieces.end(), SurfacePieces::Piece{key, 0, 0},
-                                      [](const SurfacePieces::Piece& a, const SurfacePieces::Piece& b) { return a.slot < b.slot; });
-  return {s.pieces.data() + (range.first - s.pieces.begin()), s.pieces.data() + (range.second - s.pieces.begin())};
-}
 
 // Removes the polygons of the surfaces in `ids` (sorted) from a store; returns the references
 // dropped with them. Its top becomes that of what stays.
@@ -951,24 +1033,26 @@ void ContentIndex::build(std::size_t cells, const std::vector<std::uint32_t>& so
 
 void TerrainTree::Impl::flush(BspStore& st) {
   const auto base = static_cast<std::uint32_t>(positions.size());
-  if (positions.capacity() < positions.size() + st.positions.size()) {
-    // Grown by a quarter, not doubled: lazily built slots arrive one by one.
-    const std::size_t want = std::max(positions.size() + st.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
-    positions.reserve(want);
-    merged_colors.reserve(want - merged_base());
-    if (has_tcoords) merged_tcoords.reserve(want - merged_base());
+  if (st.staged) {
+    const StagedVertices& staged = *st.staged;
+    if (positions.capacity() < positions.size() + staged.positions.size()) {
+      // Grown by a quarter, not doubled: lazily built slots arrive one by one.
+      const std::size_t want =
+          std::max(positions.size() + staged.positions.size(), positions.size() + (positions.size() - merged_base()) / 4);
+      positions.reserve(want);
+      merged_colors.reserve(want - merged_base());
+      if (has_tcoords) merged_tcoords.reserve(want - merged_base());
+    }
+    positions.insert(positions.end(), staged.positions.begin(), staged.positions.end());
+    merged_colors.insert(merged_colors.end(), staged.colors.begin(), staged.colors.end());
+    merged_tcoords.insert(merged_tcoords.end(), staged.tcoords.begin(), staged.tcoords.end());
   }
-  positions.insert(positions.end(), st.positions.begin(), st.positions.end());
-  merged_colors.insert(merged_colors.end(), st.colors.begin(), st.colors.end());
-  merged_tcoords.insert(merged_tcoords.end(), st.tcoords.begin(), st.tcoords.end());
   for (std::size_t r = st.staged_refs; r < st.refs.size(); ++r) {
     const std::uint32_t v = st.refs[r];
     st.refs[r] = (v & kTerrainRef) ? (v & ~kTerrainRef) : base + v;
   }
   st.staged_refs = static_cast<std::uint32_t>(st.refs.size());
-  release(st.positions);
-  release(st.colors);
-  release(st.tcoords);
+  st.staged.reset();
 }
 
 void TerrainTree::Impl::compact() {
@@ -1004,12 +1088,12 @@ void TerrainTree::Impl::make_content() {
   content_index = {};
   release(content);
   release(top_content);
-  std::fill(std::begin(outside), std::end(outside), -1);
+  for (auto& side : outside) side.clear();
   std::vector<std::uint32_t> cells;
   for (std::size_t k = 0; k < slots.size(); ++k) {
     const SlotKey key = slots[k].key;
     if (key >= kOutsideKey0) {
-      outside[key - kOutsideKey0] = static_cast<std::int32_t>(k);
+      outside[static_cast<std::size_t>(outside_place(key).side)].push_back(static_cast<std::int32_t>(k));
       continue;
     }
     CellName c = cell_name(*this, key / 2);
@@ -1077,10 +1161,10 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     slot.pending = 0;
     slot.top = -1e30f;
     for (const auto& [id, s] : surfaces) {
-      for (auto [it, end] = arrivals(s, key); it != end; ++it) {
+      s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) {
         ++slot.pending;
-        for (std::uint32_t r = 0; r < it->count; ++r) slot.top = std::max(slot.top, static_cast<float>(s.vertices[s.refs[it->first + r]].z));
-      }
+        for (std::uint32_t r : piece) slot.top = std::max(slot.top, static_cast<float>(s.vertices[r].z));
+      });
     }
     if (slot.pending == 0) {  // nothing left here
       removed[k] = slot.refs();
@@ -1099,7 +1183,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     SlotBuilder builder(*this, *slot.store);
     for (const auto& [id, s] : surfaces) {
       if (!anew && !std::binary_search(changed.begin(), changed.end(), id)) continue;
-      for (auto [it, end] = arrivals(s, key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+      s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
     }
     if (is_low(key)) {
       const CellName c = cell_name(*this, key / 2);
@@ -1130,12 +1214,12 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   merge_stats.rebuilt_slots += touched.size();
   for (std::size_t r : removed) dead_refs += r;
   std::size_t staged = 0;
-  for (const Slot& slot : slots) staged += slot.store ? slot.store->positions.size() : 0;
+  for (const Slot& slot : slots) staged += slot.store ? slot.store->staged_count() : 0;
   positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
   merged_colors.reserve(merged_colors.size() + staged);
   if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
   for (Slot& slot : slots) {
-    if (slot.store && (!slot.store->positions.empty() || slot.store->staged_refs < slot.store->refs.size())) flush(*slot.store);
+    if (slot.store && (slot.store->staged || slot.store->staged_refs < slot.store->refs.size())) flush(*slot.store);
   }
   std::size_t live = 0;
   for (const Slot& slot : slots) live += slot.refs();
@@ -1169,7 +1253,7 @@ void TerrainTree::Impl::build_pending(std::size_t k) {
   slot.store = std::make_unique<BspStore>();
   SlotBuilder builder(*this, *slot.store);
   for (const auto& [id, s] : surfaces) {
-    for (auto [it, end] = arrivals(s, slot.key); it != end; ++it) builder.add(s, id, std::span<const std::uint32_t>(s.refs.data() + it->first, it->count));
+    s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
   }
   const CellName c = cell_name(*this, slot.key / 2);
   builder.build_low(c.level, c.ci, c.cj);
@@ -1203,8 +1287,7 @@ void check_surface(const SurfaceInput& s) {
 }
 
 void keys_of(const SurfacePieces& s, std::vector<SlotKey>& out) {
-  for (const auto& p : s.pieces)
-    if (out.empty() || out.back() != p.slot) out.push_back(p.slot);
+  for (const SurfacePieces::Run& run : s.runs) out.push_back(run.slot);
 }
 
 }  // namespace
@@ -1242,8 +1325,23 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   merge_stats.lazy_build_ms = 0.0;
   // The overlap in the moved window's indices; a cell there was (ci + di / s, cj + dj / s).
   const Region kept{std::max(0, -di), std::max(0, -dj), n - std::max(0, di), n - std::max(0, dj)};
+  // An outside place lies where one lay before when both are one level-0 cell wide between the
+  // same planes: west and east bands (any y) move by di / s0 bands; south and north bands by
+  // dj / s0 bands and their columns by di / s0 columns. The last bands (everything beyond) stay
+  // only where their plane did not move.
+  const int s0 = cell_size(0), columns = cells_at(0);
+  const auto moved_place = [&](SlotKey key) -> std::optional<SlotKey> {
+    const OutsidePlace p = outside_place(key);
+    // A band beyond a plane that moved toward it is nearer now, and farther when it moved away.
+    const int shift = p.side == 0 ? di / s0 : p.side == 1 ? -di / s0 : p.side == 2 ? dj / s0 : -dj / s0;
+    const int band = p.band == kBands - 1 ? p.band : p.band + shift, column = p.side < 2 ? 0 : p.column - di / s0;
+    if (p.band == kBands - 1 ? shift != 0 : band < 0 || band >= kBands - 1) return std::nullopt;
+    if (column < 0 || column >= (p.side < 2 ? 1 : columns)) return std::nullopt;
+    return outside_key(p.side, band, column);
+  };
+  std::unordered_set<SlotKey> kept_places;
   const auto renamed = [&](SlotKey key) -> std::optional<SlotKey> {
-    if (key >= kOutsideKey0) return std::nullopt;  // beyond the old window: merged again
+    if (key >= kOutsideKey0) return moved_place(key);  // beyond the old window: kept where it is, else merged again
     const CellName c = cell_name(*this, key / 2);
     const int s = cell_size(c.level), ci = c.ci - di / s, cj = c.cj - dj / s;
     if (!kept.holds(ci * s, cj * s, s)) return std::nullopt;
@@ -1260,6 +1358,7 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
       continue;
     }
     slot.key = *key;
+    if (*key >= kOutsideKey0) kept_places.insert(*key);
     if (slot.store) {
       for (std::uint32_t& r : slot.store->refs) {
         if (r >= lattice_count()) continue;
@@ -1279,15 +1378,16 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
     SurfacePieces& s = surfaces[k].second;
     std::vector<SurfacePieces::Piece> pieces;
     std::vector<std::uint32_t> refs;
-    for (const SurfacePieces::Piece& p : s.pieces) {
-      const std::optional<SlotKey> key = renamed(p.slot);
+    for (std::size_t r = 0; r < s.runs.size(); ++r) {
+      const std::optional<SlotKey> key = renamed(s.runs[r].slot);
       if (!key) continue;
-      pieces.push_back({*key, static_cast<std::uint32_t>(refs.size()), p.count});
-      refs.insert(refs.end(), s.refs.begin() + p.first, s.refs.begin() + p.first + p.count);
+      s.for_each_in_run(r, [&](std::span<const std::uint32_t> piece) {
+        pieces.push_back({*key, static_cast<std::uint32_t>(refs.size()), static_cast<std::uint32_t>(piece.size())});
+        refs.insert(refs.end(), piece.begin(), piece.end());
+      });
     }
-    s.pieces = std::move(pieces);
     s.refs = std::move(refs);
-    Distributor(*this, s).run_outside(kept);
+    Distributor(*this, s).run_outside(kept, kept_places, std::move(pieces));
     std::vector<std::uint32_t> remap(s.vertices.size(), 0);
     for (std::uint32_t r : s.refs) remap[r] = 1;
     std::uint32_t used = 0;
@@ -1313,10 +1413,9 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   std::vector<std::uint32_t> ids;
   for (const auto& [id, s] : surfaces) {
     ids.push_back(id);
-    for (const SurfacePieces::Piece& p : s.pieces) {
-      if (!touched.empty() && touched.back() == p.slot) continue;
-      const auto at = std::lower_bound(slots.begin(), slots.end(), p.slot, [](const Slot& a, SlotKey b) { return a.key < b; });
-      if (at == slots.end() || at->key != p.slot) touched.push_back(p.slot);
+    for (const SurfacePieces::Run& run : s.runs) {
+      const auto at = std::lower_bound(slots.begin(), slots.end(), run.slot, [](const Slot& a, SlotKey b) { return a.key < b; });
+      if (at == slots.end() || at->key != run.slot) touched.push_back(run.slot);
     }
   }
   ++merged_version;  // the lattice vertices moved

@@ -159,6 +159,13 @@ void TerrainTree::Impl::refresh(const TerrainWindow& w) {
   }
 }
 
+double TerrainTree::Impl::band_plane(int side, int band) const {
+  const auto s0 = static_cast<std::size_t>(cell_size(0));
+  const std::vector<double>& lines = side < 2 ? xs : ys;
+  const double width = lines[s0] - lines[0];
+  return side % 2 == 0 ? lines.front() - band * width : lines.back() + band * width;
+}
+
 std::optional<std::pair<int, int>> TerrainTree::Impl::shift_of(const TerrainWindow& w) const {
   // The moved window's first plane among this one's (or this one's among the moved one's).
   const auto offset = [&](const std::vector<double>& old, std::span<const double> moved) -> std::optional<int> {
@@ -235,14 +242,16 @@ std::size_t held(const std::vector<T>& v) {
 }  // namespace
 
 std::size_t BspStore::bytes() const {
-  return held(nodes) + held(boxes) + held(polys) + held(refs) + held(positions) + held(colors);
+  std::size_t n = held(nodes) + held(boxes) + held(polys) + held(refs);
+  if (staged) n += sizeof(StagedVertices) + held(staged->positions) + held(staged->colors) + held(staged->tcoords);
+  return n;
 }
 
 void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
   const auto at = [&](std::uint32_t r) -> const glm::vec3& {
     const std::uint32_t v = refs[r];
     if (r < staged_refs) return where[v];
-    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : positions[v];
+    return (v & kTerrainRef) ? where[v & ~kTerrainRef] : staged->positions[v];
   };
   // The store's bounds first: the grid the nodes' boxes are rounded to.
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
@@ -250,14 +259,23 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
     lo = glm::min(lo, glm::dvec3(at(r)));
     hi = glm::max(hi, glm::dvec3(at(r)));
   }
-  box_base = lo;
-  box_step = glm::max((hi - lo) / 65535.0, glm::dvec3(1e-9));
+  // In single precision, the base rounded down and the step up (twice, for the base's
+  // rounding), so that 65535 steps from the base reach past the highest vertex.
+  for (int a = 0; a < 3; ++a) {
+    float b = static_cast<float>(lo[a]);
+    if (b > lo[a]) b = std::nextafter(b, -std::numeric_limits<float>::infinity());
+    float step = static_cast<float>(std::max((hi[a] - b) / 65535.0, 1e-9));
+    step = std::nextafter(std::nextafter(step, std::numeric_limits<float>::infinity()), std::numeric_limits<float>::infinity());
+    box_base[a] = b;
+    box_step[a] = step;
+  }
+  const glm::dvec3 base(box_base), step(box_step);
   const auto down = [&](const glm::vec3& p) {
-    const glm::dvec3 q = glm::floor((glm::dvec3(p) - box_base) / box_step);
+    const glm::dvec3 q = glm::floor((glm::dvec3(p) - base) / step);
     return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
   };
   const auto up = [&](const glm::vec3& p) {
-    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - box_base) / box_step);
+    const glm::dvec3 q = glm::ceil((glm::dvec3(p) - base) / step);
     return glm::clamp(q, glm::dvec3(0.0), glm::dvec3(65535.0));
   };
   boxes.assign(nodes.size(), NodeBox{});
@@ -289,7 +307,26 @@ void BspStore::bound_nodes(const std::vector<glm::vec3>& where) {
 }
 
 std::size_t SurfacePieces::bytes() const {
-  return held(triangles) + held(vertices) + held(colors) + held(pieces) + held(refs);
+  return held(triangles) + held(vertices) + held(colors) + held(tcoords) + held(runs) + held(counts) + held(refs);
+}
+
+void SurfacePieces::keep(std::vector<Piece>& gathered) {
+  std::stable_sort(gathered.begin(), gathered.end(), [](const Piece& a, const Piece& b) { return a.slot < b.slot; });
+  std::vector<std::uint32_t> sorted;
+  sorted.reserve(refs.size());
+  runs.clear();
+  std::vector<std::uint16_t>().swap(counts);
+  counts.reserve(gathered.size());
+  for (const Piece& p : gathered) {
+    if (p.count > 0xFFFFu) throw std::length_error("SurfacePieces::keep: a piece of " + std::to_string(p.count) + " vertices");
+    if (runs.empty() || runs.back().slot != p.slot) {
+      runs.push_back({p.slot, static_cast<std::uint32_t>(counts.size()), static_cast<std::uint32_t>(sorted.size())});
+    }
+    counts.push_back(static_cast<std::uint16_t>(p.count));
+    sorted.insert(sorted.end(), refs.begin() + p.first, refs.begin() + p.first + p.count);
+  }
+  refs = std::move(sorted);
+  runs.shrink_to_fit();
 }
 
 MemoryStats TerrainTree::memory() const {
@@ -577,26 +614,55 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       stack.push_back(b2f ? near_item : far_item);
       stack.push_back(b2f ? far_item : near_item);
     };
-    // The window, inside the chain of its four boundary planes: beyond each lies one kOutside
-    // slot (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]). Built from the
-    // innermost out: the window, then each boundary plane's outside slot on the far or near
-    // side of what is inside it.
-    std::uint64_t order[5];
-    int count = 0;
-    order[count++] = pack(kSquare, 0, 0, 0);
+    // The window, inside the chain of its four boundary planes: beyond each lie the kOutside
+    // slots of one side (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]), in
+    // bands parallel to the plane. Built from the innermost out: the window, then each
+    // boundary plane's bands on the far or near side of what is inside it. A side's bands are
+    // slabs between parallel planes: back to front, those farther from the eye along the axis
+    // first (slabs on opposite sides of the eye cannot overlap on screen), the one holding the
+    // eye last.
+    auto& order = frame.outside_order_;
+    order.clear();
+    order.push_back(pack(kSquare, 0, 0, 0));
+    auto& places = frame.outside_places_;
     for (int side = 3; side >= 0; --side) {
-      const std::int32_t outside_boxes = m.outside[side] < 0 && box_order ? box_order->outside(side) : -1;
-      if (m.outside[side] < 0 && outside_boxes < 0) continue;
-      const std::uint64_t slot = m.outside[side] >= 0 ? pack_slot(m.outside[side]) : pack_boxes(outside_boxes);
-      if (beyond[side] == b2f) {
-        order[count++] = slot;  // after everything inside
-      } else {
-        std::move_backward(order, order + count, order + count + 1);
-        order[0] = slot;
-        ++count;
+      const std::vector<std::int32_t>& slots = m.outside[static_cast<std::size_t>(side)];
+      // Colour boxes beyond the side in places without a slot (BoxScratch::outside_places).
+      const std::vector<BoxScratch::OutsideBoxes>* boxed = box_order ? &box_order->outside_places(side) : nullptr;
+      if (slots.empty() && (boxed == nullptr || boxed->empty())) continue;
+      // Each place is a box: its band's slab across the side's axis, its column's along the
+      // other (south and north); sorted by the band's distance from the eye, then the column's.
+      const double eye_at = side < 2 ? e.x : e.y;
+      places.clear();
+      const auto place = [&](int band, int column, std::uint64_t item) {
+        const double a = m.band_plane(side, band);
+        const double b = band + 1 < kBands ? m.band_plane(side, band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
+        double column_distance = 0.0;
+        if (side >= 2) {
+          const int s0 = m.cell_size(0);
+          const double x0 = m.xs[static_cast<std::size_t>(column * s0)], x1 = m.xs[static_cast<std::size_t>((column + 1) * s0)];
+          column_distance = e.x < x0 ? x0 - e.x : e.x > x1 ? e.x - x1 : 0.0;
+        }
+        const double lo = std::min(a, b), hi = std::max(a, b);
+        const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
+        places.push_back({band_distance, column_distance, item});
+      };
+      for (const std::int32_t slot : slots) {
+        const OutsidePlace p = outside_place(m.slots[static_cast<std::size_t>(slot)].key);
+        place(p.band, p.column, pack_slot(slot));
       }
+      if (boxed != nullptr) {
+        for (const BoxScratch::OutsideBoxes& b : *boxed) place(b.band, b.column, pack_boxes(b.bucket));
+      }
+      std::sort(places.begin(), places.end(), [&](const Frame::OutsideOrder& p, const Frame::OutsideOrder& q) {
+        if (p.band_distance != q.band_distance) return b2f ? p.band_distance > q.band_distance : p.band_distance < q.band_distance;
+        return b2f ? p.column_distance > q.column_distance : p.column_distance < q.column_distance;
+      });
+      for (const Frame::OutsideOrder& p : places) order.push_back(p.item);
+      // After everything inside, or before it.
+      if (beyond[side] != b2f) std::rotate(order.begin(), order.end() - static_cast<std::ptrdiff_t>(places.size()), order.end());
     }
-    for (int k = count; k-- > 0;) stack.push_back(order[k]);
+    for (std::size_t k = order.size(); k-- > 0;) stack.push_back(order[k]);
     while (!stack.empty()) {
       const std::uint64_t item = stack.back();
       stack.pop_back();
@@ -972,8 +1038,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
         const NodeBox& box = store.boxes[static_cast<std::size_t>(node)];
         if (box.lo[0] > box.hi[0]) return;  // holds nothing
         // Outward in double, then to floats rounded outward again: the box still holds the subtree.
-        const glm::dvec3 lo = store.box_base + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * store.box_step;
-        const glm::dvec3 hi = store.box_base + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * store.box_step;
+        const glm::dvec3 lo = glm::dvec3(store.box_base) + glm::dvec3(box.lo[0], box.lo[1], box.lo[2]) * glm::dvec3(store.box_step);
+        const glm::dvec3 hi = glm::dvec3(store.box_base) + glm::dvec3(box.hi[0], box.hi[1], box.hi[2]) * glm::dvec3(store.box_step);
         const glm::vec3 flo(std::nextafter(static_cast<float>(lo.x), -INFINITY), std::nextafter(static_cast<float>(lo.y), -INFINITY),
                             std::nextafter(static_cast<float>(lo.z), -INFINITY));
         const glm::vec3 fhi(std::nextafter(static_cast<float>(hi.x), INFINITY), std::nextafter(static_cast<float>(hi.y), INFINITY),

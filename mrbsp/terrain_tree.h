@@ -171,6 +171,12 @@ struct Frame {
   // Scratch space of the traversal, kept so that a reused Frame does not allocate.
   std::vector<std::uint64_t> stack_;
   std::vector<std::uint64_t> leaves_;
+  std::vector<std::uint64_t> outside_order_;  // the window and the outside bands, in draw order
+  struct OutsideOrder {
+    double band_distance, column_distance;
+    std::uint64_t item;  // the walk's: an outside slot, or a bucket of colour boxes
+  };
+  std::vector<OutsideOrder> outside_places_;
   std::vector<std::uint64_t> leaf_stack_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
@@ -227,17 +233,19 @@ class TerrainTree {
                 std::span<const ColorBox> boxes = {}) const;
 
   // Sliding (section 4.3): replace the heights and plane offsets for a window moved over the
-  // terrain by whole coarse cells. The node structure is kept; only plane offsets,
-  // positions, bounding boxes and errors are recomputed. Same preconditions as the
-  // constructor, and window.cells must equal cells().
+  // terrain by whole coarse cells. When the plane offsets and heights of the samples the two
+  // windows share are the same (to the bit), what lies on them is kept: their cells' figures
+  // and merged pieces (renamed to their new cells); only what enters is computed and merged.
+  // Any other window is computed and merged anew. Same preconditions as the constructor, and
+  // window.cells must equal cells().
   void slide(const TerrainWindow& window);
 
   // Merging other polygons (section 4.2). Each surface (an isosurface, a slice, ...) is kept
   // under its id; set_surface() replaces what that id held (an empty surface removes it) and
   // re-merges only the small BSPs its old and new pieces touch, so an edit costs about what
   // that surface costs. Each triangle is sent from the root through the window's boundary
-  // planes (what lies outside the window is kept in four BSPs beyond them) and the cells'
-  // split planes, classified in double precision with a tolerance of 1e-9 times the window
+  // planes (what lies outside the window is kept in small BSPs beyond them, in bands one
+  // level-0 cell wide) and the cells' split planes, classified in double precision with a tolerance of 1e-9 times the window
   // size; at a cell of an LOD level, a piece entirely above the cell's terrain (above zmax)
   // stays there whole, in a small BSP ordered against all of the cell's terrain by the plane
   // z = zmax; a piece entirely below the cell's terrain (below zmin) is dropped, since no eye

@@ -12,9 +12,12 @@
 // triangles) and its children (the high alternative).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -69,25 +72,33 @@ struct NodeBox {
 };
 inline constexpr std::int32_t kDropSide = -2;
 
+// Vertices made while a small BSP is built, before Impl::flush() moves them into the tree's
+// merged vertices.
+struct StagedVertices {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::u8vec4> colors;
+  std::vector<glm::vec2> tcoords;
+};
+
 // The small BSP of one slot: nodes, polygons and references (indices into positions()). New
-// vertices are staged in `positions` and `colors`, with the references made since
-// `staged_refs` pointing into them, until Impl::flush() moves them into the tree's merged
-// vertices and makes those references global.
+// vertices are staged (`staged`), with the references made since `staged_refs` pointing into
+// them, until Impl::flush() moves them into the tree's merged vertices, makes those references
+// global and lets `staged` go. Kept small: there is one per built slot (17,763 in the
+// benchmark scene).
 struct BspStore {
   std::vector<BspNode> nodes;
   std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
-  glm::dvec3 box_base{0.0}, box_step{1.0};  // the boxes' grid: the store's bounds in 65535 steps
+  glm::vec3 box_base{0.0f}, box_step{1.0f};  // the boxes' grid: the store's bounds in at most 65535 steps
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
-  std::vector<glm::vec3> positions;  // staged, empty once flushed
-  std::vector<glm::u8vec4> colors;
-  std::vector<glm::vec2> tcoords;
+  std::unique_ptr<StagedVertices> staged;  // null when nothing is staged
   std::uint32_t staged_refs = 0;
   std::int32_t root = -1;
-  std::size_t pieces = 0;   // merged polygons (terrain triangles not counted)
-  std::size_t dropped = 0;  // pieces found below the low triangles and dropped
-  float top = -1e30f;       // highest merged vertex ever put in (an upper bound after removals)
+  std::uint32_t pieces = 0;   // merged polygons (terrain triangles not counted)
+  std::uint32_t dropped = 0;  // pieces found below the low triangles and dropped
+  float top = -1e30f;         // highest merged vertex ever put in (an upper bound after removals)
   std::size_t bytes() const;
+  std::size_t staged_count() const { return staged ? staged->positions.size() : 0; }
   // Sets every node's subtree box (boxes, box_base, box_step) from its polygons' vertices: references
   // into `where` (the tree's positions()), and those made since staged_refs as staged (before
   // Impl::flush(); so boxes can be set while slots are built in parallel). Children follow
@@ -101,14 +112,32 @@ struct BspStore {
 // plane z = zmax: the eye's side of it is near), kLow the cell's low alternative: its two
 // terrain triangles and the pieces above them. Around the window, kOutside slots hold what
 // lies beyond its four boundary planes (west, east, south, north, in this order: a piece
-// beyond two belongs to the first).
+// beyond two belongs to the first), in bands one level-0 cell wide parallel to the plane: band
+// b of the west side lies between the planes x = xs[0] - (b + 1) w and x = xs[0] - b w (w the
+// level-0 cell's width), the last band (kBands - 1) everything beyond; south and north bands
+// lie between the west and east planes, cut further into the window's level-0 columns. A slide
+// by whole level-0 cells keeps most of them (Impl::shift_merged), and they are built apart (in
+// parallel, and none as large as all of a side).
 enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
+inline constexpr int kBands = 16;
+inline constexpr int kMaxColumns = 32768;  // level-0 columns of a window, at most
 
 // A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
-// kOutsideKey0 + side (0 west, 1 east, 2 south, 3 north). Cells number at most 1.5e9 (a
-// 32768-cell window), so keys fit 32 bits below kOutsideKey0.
+// outside_key(side, band, column) (side 0 west, 1 east, 2 south, 3 north; column 0 for west and
+// east). Cells number at most 1.5e9 (a 32768-cell window), so keys fit 32 bits below
+// kOutsideKey0.
 using SlotKey = std::uint32_t;
-inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFF0u;
+inline constexpr SlotKey kOutsideKey0 = 0xFFFFFFFFu - 4u * kBands * kMaxColumns;
+inline constexpr SlotKey outside_key(int side, int band, int column) {
+  return kOutsideKey0 + static_cast<SlotKey>((side * kBands + band) * kMaxColumns + column);
+}
+struct OutsidePlace {
+  int side, band, column;
+};
+inline constexpr OutsidePlace outside_place(SlotKey key) {
+  const auto k = static_cast<int>(key - kOutsideKey0);
+  return {k / kMaxColumns / kBands, k / kMaxColumns % kBands, k % kMaxColumns};
+}
 
 // Which cells hold merged content, and where its record is: a bit per cell and the count of
 // set bits before each 64-bit word (rank), so a record is found in O(1) with 1.5 bits per cell.
@@ -131,8 +160,8 @@ struct CellContent {
 };
 
 // One surface's polygons after distribution through the tree's planes (merge.cpp): pieces
-// arrived at slots, in the order they were made. Vertices are the input's followed by those
-// made by splitting (double precision, for classification).
+// arrived at slots, kept by slot and in the order they were made within a slot. Vertices are
+// the input's followed by those made by splitting (double precision, for classification).
 struct SurfacePieces {
   std::size_t input_triangles = 0;
   std::size_t input_vertices = 0;           // the first vertices are the input's
@@ -140,16 +169,42 @@ struct SurfacePieces {
   std::vector<glm::dvec3> vertices;
   std::vector<glm::u8vec4> colors;
   std::vector<glm::vec2> tcoords;  // empty, or one per vertex
+  // A piece while pieces are gathered (Distributor): its `count` references from refs[first].
   struct Piece {
     SlotKey slot;
-    std::uint32_t first;  // into refs
+    std::uint32_t first;
     std::uint32_t count;
   };
-  static_assert(sizeof(Piece) == 12);
-  std::vector<Piece> pieces;  // sorted by slot, stable
+  // The pieces kept, 2 bytes each rather than a Piece's 12 (most of them wait in low slots
+  // never built): run k is the pieces [runs[k].piece0, runs[k + 1].piece0) of slot
+  // runs[k].slot (runs sorted by slot), their references one after the other in `refs` from
+  // runs[k].ref0, counts[p] of them for piece p.
+  struct Run {
+    SlotKey slot;
+    std::uint32_t piece0, ref0;
+  };
+  std::vector<Run> runs;
+  std::vector<std::uint16_t> counts;
   std::vector<std::uint32_t> refs;
   std::size_t dropped = 0;  // pieces found below the terrain and dropped
   std::size_t bytes() const;
+  std::size_t piece_count() const { return counts.size(); }
+  // Calls f(std::span<const std::uint32_t>) with the references of each piece of run k.
+  template <class F>
+  void for_each_in_run(std::size_t k, F&& f) const {
+    const std::uint32_t end = k + 1 < runs.size() ? runs[k + 1].piece0 : static_cast<std::uint32_t>(counts.size());
+    const std::uint32_t* r = refs.data() + runs[k].ref0;
+    for (std::uint32_t p = runs[k].piece0; p < end; r += counts[p], ++p) f(std::span<const std::uint32_t>(r, counts[p]));
+  }
+  // The same for the pieces that arrived at slot `key` (none when none did).
+  template <class F>
+  void for_each_arrival(SlotKey key, F&& f) const {
+    const auto at = std::lower_bound(runs.begin(), runs.end(), key, [](const Run& a, SlotKey b) { return a.slot < b; });
+    if (at != runs.end() && at->slot == key) for_each_in_run(static_cast<std::size_t>(at - runs.begin()), f);
+  }
+  // Keeps `gathered` (pieces into refs, in any order): sorted by slot (stable), refs reordered
+  // to match. Throws std::length_error for a piece of more than 65535 vertices.
+  void keep(std::vector<Piece>& gathered);
 };
 
 // A slot and its small BSP. Above and outside slots are built when merged; low slots only
@@ -189,7 +244,8 @@ struct TerrainTree::Impl {
   ContentIndex content_index;        // cells with content -> their record in `content`
   std::vector<CellContent> content;  // in cell id order
   std::vector<std::vector<float>> top_content;  // per top level: highest content per cell (or -inf)
-  std::int32_t outside[4] = {-1, -1, -1, -1};     // slot indices of the kOutside slots
+  // The kOutside slots (indices into slots) of each side.
+  std::array<std::vector<std::int32_t>, 4> outside;
   std::vector<glm::u8vec4> merged_colors;
   std::vector<glm::vec2> merged_tcoords;  // one per merged vertex while has_tcoords, else empty
   bool has_tcoords = false;               // some surface has texture coordinates
@@ -230,6 +286,10 @@ struct TerrainTree::Impl {
   // (di, dj) when `window` is this one moved by di columns and dj rows (multiples of the
   // level-0 cell size, less than the window) over the same terrain; nothing otherwise.
   std::optional<std::pair<int, int>> shift_of(const TerrainWindow& window) const;
+  // The plane offset where outside band `band` of `side` ends toward the window (band 0: the
+  // boundary plane itself) and its width (a level-0 cell's), along x for west and east, y for
+  // south and north.
+  double band_plane(int side, int band) const;
   // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
   // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the
   // triangles reaching beyond the overlap merged into the rest of the window.

@@ -49,6 +49,7 @@ struct FlyOptions {
   std::optional<double> threshold, start, end;
   int crf = 20;
   int samples = 1;
+  RendererChoice drawn;  // --renderer, --aa
   bool resume = false, force = false;
   std::vector<std::string> objects;  // --object, added to the scene's
   std::string density;               // --density: replaces every volume's density style
@@ -144,7 +145,13 @@ void run_fly(const FlyOptions& o) {
   const double threshold_scale = traversal.metric == mrbsp::LodMetric::kError ? factor : factor * factor;
   const double default_fov = scene.camera ? scene.camera->fov_y_deg : 45.0;
 
-  render::require_x_display("fly");
+  const bool tiled = o.drawn.engine == scene::Engine::kTiler;
+  check_tiler_size(o.drawn, width, height);
+  if (tiled && st.order != scene::DrawOrder::kBsp) {
+    throw std::invalid_argument(source + ": scene: \"order\": \"" + scene::order_name(st.order) +
+                                "\": --renderer tiler draws in the tree's own order (bsp)");
+  }
+  if (!tiled) render::require_x_display("fly");
   // Outputs: nothing is replaced without --force; a PNG folder resumes only what it started.
   if (!o.stats.empty() && !o.force && std::filesystem::exists(o.stats)) {
     throw std::runtime_error(o.stats.string() + ": exists (use --force to overwrite)");
@@ -156,6 +163,10 @@ void run_fly(const FlyOptions& o) {
                    {"fps", o.fps},
                    {"threshold", default_threshold},
                    {"samples", o.samples}};
+  if (tiled) {  // frames of another renderer or sampling are other frames (absent: VTK, as before)
+    manifest["renderer"] = scene::engine_name(o.drawn.engine);
+    manifest["aa"] = o.drawn.aa;
+  }
   if (video) {
     if (o.resume) throw std::invalid_argument("--resume: only a PNG folder export resumes; a video is written whole");
     if (!o.force && std::filesystem::exists(o.output)) {
@@ -212,6 +223,13 @@ void run_fly(const FlyOptions& o) {
                                      "); use --force to start over");
           }
         }
+        // A key only the folder's manifest has (its frames are the tiler's, this run VTK's).
+        for (const auto& [key, value] : before.items()) {
+          if (!manifest.contains(key)) {
+            throw std::runtime_error(o.output.string() + ": its frames were made with another " + key + " (" +
+                                     value.dump() + ", now none); use --force to start over");
+          }
+        }
       }
       const auto missing = output::first_missing_frame(o.output, first, last, digits);
       if (!missing) {
@@ -233,9 +251,11 @@ void run_fly(const FlyOptions& o) {
   render::RenderSettings settings = render::render_settings(st);
   settings.width = width * factor;
   settings.height = height * factor;
-  render::SceneOptions options = render::scene_options(st);
-  options.density.threshold_px *= factor;  // in output pixels, like the LOD threshold
-  render::SceneRenderer renderer(std::move(mosaic), scene, settings, options);
+  render::SceneOptions scene_opts = render::scene_options(st);
+  scene_opts.engine = o.drawn.engine;
+  scene_opts.tiler.aa = o.drawn.aa;
+  scene_opts.density.threshold_px *= factor;  // in output pixels, like the LOD threshold
+  render::SceneRenderer renderer(std::move(mosaic), scene, settings, scene_opts);
 
   const scene::CameraPath path(
       file.keys, renderer.frame(), [&renderer](double lat, double lon) { return renderer.ground_height(lat, lon); },
@@ -334,10 +354,11 @@ void run_fly(const FlyOptions& o) {
 
 void add_fly_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("fly", "Export a scripted flythrough (camera path JSON) to a video or PNG frames "
-                                        "(needs an X display; docs/camera-paths.md)");
+                                        "(VTK needs an X display, --renderer tiler does not; docs/camera-paths.md)");
   auto o = std::make_shared<FlyOptions>();
   struct Raw {
     double threshold = 0, start = 0, end = 0, density_threshold = 0;
+    RendererArgs renderer;
   };
   auto raw = std::make_shared<Raw>();
   cmd->add_option("path", o->path, "Camera path file (JSON)")->required();
@@ -359,11 +380,17 @@ void add_fly_command(CLI::App& app) {
                   "Antialiasing: samples per pixel, 1, 4, 9 or 16 (supersampling: rendered at 1x, 2x, 3x or 4x "
                   "the size and box-filtered down)")
       ->capture_default_str();
+  add_renderer_options(*cmd, raw->renderer);
   cmd->callback([o, raw, threshold, start, end, density_threshold] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
     if (o->samples != 1 && o->samples != 4 && o->samples != 9 && o->samples != 16) {
       throw std::invalid_argument("--samples " + std::to_string(o->samples) + ": must be 1, 4, 9 or 16");
+    }
+    o->drawn = resolve_renderer(raw->renderer);
+    if (o->drawn.engine == scene::Engine::kTiler && o->samples != 1) {
+      throw std::invalid_argument("--samples " + std::to_string(o->samples) +
+                                  ": VTK's supersampling; --renderer tiler antialiases with --aa");
     }
     if (o->resume && o->force) throw std::invalid_argument("--resume and --force: give one (continue, or start over)");
     if (threshold->count() > 0) {

@@ -1,6 +1,8 @@
 // `terravol render DEM... --camera LAT,LON,ALT,HEADING,PITCH -o out.png`: one offscreen image
 // of the terrain, drawn in the MRBSP tree's back-to-front order with no depth buffer (or, with
-// --order zbuffer, the same triangles with VTK's depth test, as the reference).
+// --order zbuffer, the same triangles with VTK's depth test, as the reference); or, with
+// --renderer tiler, its front-to-back order tiled in software with --aa x --aa samples a pixel
+// (tiler/, Greene 1996).
 #include <nlohmann/json.hpp>
 
 #include <vtkCamera.h>
@@ -24,6 +26,7 @@
 #include "app/output/write_file.h"
 #include "app/render/scene_renderer.h"
 #include "app/render/terrain_renderer.h"
+#include "app/render/tiled_renderer.h"
 #include "app/scene/camera.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
@@ -55,6 +58,8 @@ struct RenderOptions {
   std::filesystem::path export_vtp;  // optional
   std::vector<scene::VolumeSpec> volumes;  // RF volumes and their styles
   std::vector<scene::ObjectSpec> objects;  // models placed on the terrain
+  scene::Engine engine = scene::Engine::kVtk;  // --renderer
+  int aa = 8;                                  // --aa (the tiler's samples per pixel per axis)
 };
 
 void run_render(const RenderOptions& o) {
@@ -93,15 +98,22 @@ void run_render(const RenderOptions& o) {
   scene.objects = o.objects;
   scene.camera = scene::SceneCamera{o.pose, o.agl, o.fov_y_deg};
   const auto t_scene = Clock::now();
-  render::SceneRenderer view(scene, settings, render::scene_options(st, o.levels));
+  render::SceneOptions options = render::scene_options(st, o.levels);
+  options.engine = o.engine;
+  options.tiler.aa = o.aa;
+  render::SceneRenderer view(scene, settings, options);
   const double scene_ms = ms_since(t_scene);
+  const bool tiled = o.engine == scene::Engine::kTiler;
 
   // Two frames: the first pays for the upload of the vertices and the shaders; the second is
   // what every later frame of a flythrough costs.
   const render::FrameStats first = view.render(o.pose, o.agl, o.fov_y_deg, traversal);
   const render::FrameStats f = view.render(o.pose, o.agl, o.fov_y_deg, traversal);
 
-  output::write_png(o.output, output::window_png(view.renderer().window()), o.force);
+  output::write_png(o.output,
+                    tiled ? output::encode_png(view.rgb(), settings.width, settings.height)
+                          : output::window_png(view.renderer().window()),
+                    o.force);
   std::printf("wrote %s\n", o.output.string().c_str());
   const scene::MergeFigures& merge = view.merge_figures();
   if (view.volume_count() > 0) {
@@ -139,7 +151,26 @@ void run_render(const RenderOptions& o) {
     j["output"] = o.output.string();
     j["width"] = settings.width;
     j["height"] = settings.height;
+    j["renderer"] = scene::engine_name(o.engine);
     j["order"] = scene::order_name(settings.order);
+    if (tiled) {
+      const tiler::Stats& t = view.tiled().stats();
+      const double pixels = static_cast<double>(settings.width) * settings.height;
+      j["tiler"] = {{"aa", o.aa},
+                    {"texel_rate", view.tiled().settings().texel_rate},
+                    {"triangles", t.triangles},
+                    {"translucent", t.translucent},
+                    {"clipped", t.clipped},
+                    {"fragments", t.fragments},
+                    {"shading_points", t.shading_points},
+                    {"samples_covered", t.samples_covered},
+                    {"samples_background", t.samples_background},
+                    {"cells_visited_per_pixel", static_cast<double>(t.cells_visited) / pixels},
+                    {"class_splits", t.class_splits},
+                    {"setup_ms", t.setup_ms},
+                    {"tile_ms", t.tile_ms},
+                    {"tile_cpu_ms", t.tile_cpu_ms}};
+    }
     j["lod_metric"] = scene::metric_name(traversal.metric);
     j["threshold_px"] = traversal.threshold_px;
     j["full_res"] = traversal.full_res;
@@ -222,10 +253,11 @@ void run_render(const RenderOptions& o) {
 
 void add_render_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render the terrain of DEM files, and RF volumes over it, to a PNG image "
-                                           "(needs an X display)");
+                                           "(VTK needs an X display; --renderer tiler does not)");
   struct Raw {
     RenderOptions o;
     std::string camera, background;
+    RendererArgs renderer;
     SceneArgs scene;
   };
   auto raw = std::make_shared<Raw>();
@@ -246,8 +278,19 @@ void add_render_command(CLI::App& app) {
   cmd->add_flag("--force", o.force, "Replace existing output files");
   cmd->add_option("--stats", o.stats, "Write figures of the render (JSON)");
   cmd->add_option("--export-vtp", o.export_vtp, "Write the triangles drawn, in draw order (VTK XML PolyData)");
+  add_renderer_options(*cmd, raw->renderer);
   cmd->callback([=] {
     RenderOptions& opt = raw->o;
+    const RendererChoice drawn = resolve_renderer(raw->renderer);
+    opt.engine = drawn.engine;
+    opt.aa = drawn.aa;
+    if (opt.engine == scene::Engine::kTiler) {
+      if (opt.wireframe || opt.lod_colors) {
+        throw std::invalid_argument(std::string("--renderer tiler: draws filled triangles only (no ") +
+                                    (opt.wireframe ? "--wireframe" : "--lod-colors") + ")");
+      }
+      if (!opt.export_vtp.empty()) throw std::invalid_argument("--export-vtp: needs --renderer vtk (the VTK polydata it writes)");
+    }
     // The scene file first; whatever the command line gave wins.
     const scene::SceneSpec file = read_scene_args(raw->scene, opt.dems);
     const auto pose = scene::resolve_camera(file, camera->count() > 0 ? &raw->camera : nullptr, fov->count() > 0,
@@ -259,6 +302,11 @@ void add_render_command(CLI::App& app) {
     opt.objects = file.objects;
     if (!raw->background.empty()) opt.background = scene::parse_rgb("--background", raw->background);
     scene::check_view_options(opt.fov_y_deg, opt.style, levels->count() > 0, opt.levels);
+    if (opt.engine == scene::Engine::kTiler && opt.style.order != scene::DrawOrder::kBsp) {
+      throw std::invalid_argument(std::string("--renderer tiler: draws in the tree's own order (--order bsp), not --order ") +
+                                  scene::order_name(opt.style.order));
+    }
+    check_tiler_size(drawn, opt.style.width, opt.style.height);
     run_render(opt);
   });
 }

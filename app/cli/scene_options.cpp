@@ -99,6 +99,33 @@ std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& tex
   return out;
 }
 
+void add_renderer_options(CLI::App& cmd, RendererArgs& args) {
+  cmd.add_option("--renderer", args.renderer,
+                 "vtk (OpenGL through VTK, needs an X display) or tiler (software: the tree's front-to-back order "
+                 "tiled into a coverage pyramid, antialiased by --aa)")
+      ->capture_default_str();
+  args.aa_option = cmd.add_option("--aa", args.aa, "With --renderer tiler: samples per pixel per axis, 1, 2, 4 or 8")
+                       ->capture_default_str();
+}
+
+RendererChoice resolve_renderer(const RendererArgs& args) {
+  RendererChoice c{scene::parse_engine(args.renderer), scene::parse_aa(args.aa)};
+  if (c.engine == scene::Engine::kVtk && args.aa_option != nullptr && args.aa_option->count() > 0) {
+    throw std::invalid_argument("--aa: needs --renderer tiler (VTK antialiases by supersampling: fly --samples)");
+  }
+  return c;
+}
+
+void check_tiler_size(const RendererChoice& choice, int width, int height) {
+  if (choice.engine != scene::Engine::kTiler) return;
+  const int most = 16384 / choice.aa;
+  if (width > most || height > most) {
+    throw std::invalid_argument("--size " + std::to_string(width) + "x" + std::to_string(height) + " at --aa " +
+                                std::to_string(choice.aa) + ": at most 16384 samples per side (" + std::to_string(most) +
+                                " pixels)");
+  }
+}
+
 scene::SceneStyle given_style(const SceneArgs& args) {
   const StyleArgs& s = args.style;
   const auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };

@@ -51,6 +51,23 @@ CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold);
 // The scene objects of --object texts (scene::parse_object; the files are read later).
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts);
 
+// --renderer vtk|tiler and --aa 1|2|4|8, as given (render and fly share them).
+struct RendererArgs {
+  std::string renderer = "vtk", aa = "8";
+  CLI::Option* aa_option = nullptr;
+};
+void add_renderer_options(CLI::App& cmd, RendererArgs& args);
+// What they name. Throws std::invalid_argument (one line naming the option and the text) for a
+// bad value, or --aa given without --renderer tiler.
+struct RendererChoice {
+  scene::Engine engine = scene::Engine::kVtk;
+  int aa = 8;
+};
+RendererChoice resolve_renderer(const RendererArgs& args);
+// With the tiler: throws std::invalid_argument naming --size and --aa unless width * aa and
+// height * aa are at most 16384 samples (its pyramid's limit).
+void check_tiler_size(const RendererChoice& choice, int width, int height);
+
 // The style keys the command line gave: each style option given, and legend false with
 // --no-legend. Throws std::invalid_argument for a bad --size.
 scene::SceneStyle given_style(const SceneArgs& args);

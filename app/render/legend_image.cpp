@@ -71,8 +71,8 @@ std::array<int, 2> text_size(vtkTextProperty* style, const std::string& text) {
   return {box[1] - box[0] + 1, box[3] - box[2] + 1};
 }
 
-// Draws `text` with its top-left corner at (x, y) of the canvas (row 0 at the top).
-void draw_text(Canvas& canvas, vtkTextProperty* style, const std::string& text, int x, int y) {
+// Draws `text` in `ink` with its top-left corner at (x, y) of the canvas (row 0 at the top).
+void draw_text(Canvas& canvas, vtkTextProperty* style, const std::string& text, int x, int y, glm::u8vec3 ink = kInk) {
   vtkNew<vtkImageData> image;
   int dims[2] = {0, 0};
   if (!vtkFreeTypeTools::GetInstance()->RenderString(style, vtkStdString(text), kDpi, image.GetPointer(), dims)) {
@@ -86,7 +86,7 @@ void draw_text(Canvas& canvas, vtkTextProperty* style, const std::string& text, 
     for (int ix = 0; ix < dims[0]; ++ix) {
       const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer(extent[0] + ix, extent[2] + iy, 0));
       const int a = comps == 4 ? p[3] : p[0];
-      canvas.blend(x + ix, y + dims[1] - 1 - iy, kInk, a);
+      canvas.blend(x + ix, y + dims[1] - 1 - iy, ink, a);
     }
   }
 }
@@ -186,6 +186,16 @@ RgbaImage draw_card(const LegendCard& card, int title_px, int body_px, int bar_h
 }
 
 }  // namespace
+
+RgbaImage text_image(const std::string& text, int size, bool bold, glm::u8vec3 color, bool shadow) {
+  const auto style = text_style(size, bold);
+  const auto [w, h] = text_size(style, text);
+  const int pad = shadow ? 1 : 0;
+  Canvas canvas(w + pad, h + pad);
+  if (shadow) draw_text(canvas, style, text, 1, 1, glm::u8vec3(0, 0, 0));
+  draw_text(canvas, style, text, 0, 0, color);
+  return {canvas.width, canvas.height, std::move(canvas.rgba)};
+}
 
 glm::u8vec3 map_color(const volume::Colormap& colormap, double lo, double hi, double v) {
   return colormap.map(hi == lo ? 0.5 : (v - lo) / (hi - lo));

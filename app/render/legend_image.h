@@ -47,6 +47,12 @@ struct RgbaImage {
 // smallest. Throws std::runtime_error when FreeType cannot draw the text.
 RgbaImage legend_image(const LegendCard& card, int max_height = 0);
 
+// A line of text as RGBA (row 0 at the top, transparent around the glyphs): FreeType through
+// vtkFreeTypeTools, `size` px, bold or not, in `color`; with `shadow`, under it the same in
+// black one pixel right and down (vtkTextProperty's shadow). For the tiler's marker labels.
+// Throws std::runtime_error when FreeType cannot draw the text.
+RgbaImage text_image(const std::string& text, int size, bool bold, glm::u8vec3 color, bool shadow);
+
 // The round values the bar is labelled at in [min(lo, hi), max(lo, hi)], ascending: the
 // largest step of 1, 2 or 5 times a power of ten that gives at least 3 labels. {lo} when
 // lo == hi.

@@ -74,7 +74,20 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
     : mosaic_(std::move(mosaic)), settings_(settings), options_(options), density_options_(options.density) {
   const scene::CameraPose at = scene.camera ? scene.camera->pose : scene::default_pose(mosaic_);
   scene::require_near(mosaic_, at.lat, at.lon);
-  require_x_display();
+  if (options_.engine == scene::Engine::kTiler) {
+    if (settings_.order != scene::DrawOrder::kBsp || settings_.wireframe || settings_.lod_colors) {
+      throw std::invalid_argument("the tiler draws filled triangles in the tree's order only (--order bsp, no "
+                                  "--wireframe or --lod-colors)");
+    }
+    for (const scene::VolumeSpec& v : scene.volumes) {
+      if (v.density) throw std::invalid_argument("the tiler does not draw densities (--renderer vtk draws them)");
+    }
+    options_.tiler.width = settings_.width;
+    options_.tiler.height = settings_.height;
+    tiled_ = std::make_unique<TiledRenderer>(options_.tiler);  // throws for bad settings before the scene is read
+  } else {
+    require_x_display();
+  }
   const scene::LatticePoint p = scene::lattice_point(mosaic_, at.lat, at.lon);
   const scene::WindowChoice window =
       scene::choose_window(mosaic_.rows(), mosaic_.cols(), p.row, p.col, options_.max_window);
@@ -95,6 +108,11 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
       scene.objects, [this](double lat, double lon) { return ground_height(lat, lon); }, scene_->frame(), options_.lod);
   lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
                                   options_.shading);
+  if (tiled_) {
+    if (options_.legend) tiled_->set_legend(volumes_.legend());
+    tiled_->set_labels(volumes_.marker_labels());
+    return;
+  }
   const mrbsp::TerrainTree& tree = scene_->tree();
   renderer_ = std::make_unique<TerrainRenderer>(
       tree.positions(), scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()), settings_,
@@ -102,6 +120,16 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
   renderer_->set_vertex_version(tree.merged_version());
   if (options_.legend) renderer_->set_legend(volumes_.legend());
   renderer_->set_labels(volumes_.marker_labels());
+}
+
+TerrainRenderer& SceneRenderer::renderer() {
+  if (!renderer_) throw std::logic_error("SceneRenderer::renderer: the scene is drawn by the tiler, not VTK");
+  return *renderer_;
+}
+
+const TiledRenderer& SceneRenderer::tiled() const {
+  if (!tiled_) throw std::logic_error("SceneRenderer::tiled: the scene is drawn by VTK, not the tiler");
+  return *tiled_;
 }
 
 SceneRenderer::~SceneRenderer() = default;
@@ -182,11 +210,11 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const auto t0 = Clock::now();
   // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
   // tree slides and merges again, so the merge's scratch does not come on top of them.
-  renderer_->release_vertices();
+  if (renderer_) renderer_->release_vertices();
   try {
     scene_->slide(std::move(p.window));  // merges the volumes' polygons again into the moved window
   } catch (...) {
-    sync_vertices(*renderer_);  // the scene kept its window: all of its vertices again
+    if (renderer_) sync_vertices(*renderer_);  // the scene kept its window: all of its vertices again
     throw;
   }
   return_freed_memory();  // the old vertices and the merge's scratch
@@ -200,9 +228,11 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   lattice_ = std::move(p.lattice);
   const auto t1 = Clock::now();
   const mrbsp::TerrainTree& tree = scene_->tree();
-  if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-  renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
-  renderer_->set_vertex_version(tree.merged_version());
+  if (renderer_) {
+    if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
+    renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+    renderer_->set_vertex_version(tree.merged_version());
+  }
   p.vertices = {};
   return_freed_memory();  // the upload's shading copies
   last_slide_ = {p.read_ms, p.shade_ms, tree_ms, ms_since(t1)};
@@ -267,13 +297,18 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   const double beyond_x = std::max({scene_->xs().front() - ex, ex - scene_->xs().back(), 0.0});
   const double beyond_y = std::max({scene_->ys().front() - ey, ey - scene_->ys().back(), 0.0});
   const double clearance = std::max(stats.eye_height - stats.ground_height, std::hypot(beyond_x, beyond_y));
-  const int* size = renderer_->window()->GetSize();
-  camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg, std::max(size[0], 1),
-                                     std::max(size[1], 1), scene::near_plane_for(clearance));
-  renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
-  if (renderer_->settings().gradient) {
-    const auto sky = scene::sky_gradient(pose.pitch_deg, fov_y_deg);
-    renderer_->set_background(sky[0], sky[1]);
+  const int* size = renderer_ ? renderer_->window()->GetSize() : nullptr;
+  camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg,
+                                     size ? std::max(size[0], 1) : settings_.width, size ? std::max(size[1], 1) : settings_.height,
+                                     scene::near_plane_for(clearance));
+  const auto sky = settings_.gradient ? scene::sky_gradient(pose.pitch_deg, fov_y_deg)
+                                      : std::array<scene::Rgb, 2>{settings_.background, settings_.background};
+  if (renderer_) {
+    renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
+    if (renderer_->settings().gradient) renderer_->set_background(sky[0], sky[1]);
+  } else {
+    sky_ = sky;
+    far_plane_ = scene_->far_plane(camera_.eye);
   }
 
   auto t0 = Clock::now();
@@ -281,16 +316,23 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   stats.objects_ms = ms_since(t0);
   stats.objects_merged = objects_.figures().remerged;
   t0 = Clock::now();
-  boxes_.clear();
-  volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
-  stats.density_ms = ms_since(t0);
-  t0 = Clock::now();
-  scene_->tree().traverse(camera_, traversal, frame_, boxes_);
+  if (tiled_) {
+    const int aa = tiled_->settings().aa;
+    scene_->tree().traverse(tiled_traversal_camera(camera_, traversal, aa), tiled_traversal(traversal, aa), frame_);
+  } else {
+    boxes_.clear();
+    volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+    stats.density_ms = ms_since(t0);
+    t0 = Clock::now();
+    scene_->tree().traverse(camera_, traversal, frame_, boxes_);
+  }
   stats.traversal_ms = ms_since(t0);
   stats.boxes = frame_.boxes;
   t0 = Clock::now();
-  sync_vertices(*renderer_);  // the low alternatives the traversal built appended vertices
-  renderer_->set_frame(frame_);
+  if (renderer_) {
+    sync_vertices(*renderer_);  // the low alternatives the traversal built appended vertices
+    renderer_->set_frame(frame_);
+  }
   stats.upload_ms = ms_since(t0);
   stats.triangles = frame_.indices.size() / 3;
   stats.merged_triangles = static_cast<std::size_t>(
@@ -301,7 +343,13 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   return stats;
 }
 
-double SceneRenderer::draw() { return renderer_->render(); }
+double SceneRenderer::draw() {
+  if (tiled_) {
+    return tiled_->draw(scene_->tree(), lattice_, frame_, camera_, far_plane_, sky_[0], sky_[1], settings_.haze_distance,
+                        settings_.haze_color);
+  }
+  return renderer_->render();
+}
 
 bool SceneRenderer::slide_for(const scene::CameraPose& pose) {
   scene::require_near(mosaic_, pose.lat, pose.lon);
@@ -329,6 +377,11 @@ std::unique_ptr<TerrainRenderer> SceneRenderer::make_renderer(const RenderSettin
 
 const scene::MergeFigures& SceneRenderer::remerge() {
   volumes_.merge_into(*scene_);
+  if (tiled_) {
+    if (options_.legend) tiled_->set_legend(volumes_.legend());
+    tiled_->set_labels(volumes_.marker_labels());
+    return volumes_.figures();
+  }
   sync_vertices(*renderer_);
   if (options_.legend) renderer_->set_legend(volumes_.legend());
   renderer_->set_labels(volumes_.marker_labels());
@@ -352,11 +405,11 @@ double SceneRenderer::set_path(const volume::Mesh& path) {
   const std::uint32_t id = scene::kProfilePathId;
   const mrbsp::SurfaceInput input{path.vertices, path.colors, path.triangles};
   scene_->set_surfaces(std::span(&id, 1), std::span(&input, 1));
-  sync_vertices(*renderer_);
+  if (renderer_) sync_vertices(*renderer_);
   return ms_since(t0);
 }
 
-std::vector<std::uint8_t> SceneRenderer::rgb() const { return renderer_->rgb(); }
+std::vector<std::uint8_t> SceneRenderer::rgb() const { return tiled_ ? tiled_->rgb() : renderer_->rgb(); }
 
 std::optional<Pick> SceneRenderer::pick(int x, int y) const {
   const auto t0 = scene::Clock::now();

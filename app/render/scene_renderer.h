@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/render/terrain_renderer.h"
+#include "app/render/tiled_renderer.h"
 #include "app/scene/camera.h"
 #include "app/scene/object_layer.h"
 #include "app/scene/pick.h"
@@ -64,6 +65,12 @@ struct SceneOptions {
   std::size_t surface_triangles = scene::kDefaultSurfaceTriangles;  // per isosurface or slice; 0: all
   objects::LodOptions lod;  // the objects' levels of detail (scene::ObjectLayer)
   Sliding sliding = Sliding::kSynchronous;
+  // What draws the frames: VTK (TerrainRenderer), or the coverage-mask tiler (TiledRenderer:
+  // no VTK window, no X display; the traversal runs front to back, tiled_traversal). The
+  // tiler draws filled triangles in the tree's order only: RenderSettings' order must be kBsp,
+  // without wireframe or LOD colours.
+  scene::Engine engine = scene::Engine::kVtk;
+  tiler::Settings tiler;  // kTiler: aa, texel rate, bands, threads (the size is the RenderSettings')
   density::RefineOptions density;  // how the density is refined (threshold: epsilon, pixels)
 };
 
@@ -122,7 +129,7 @@ class SceneRenderer {
   // be read.
   FrameStats prepare(const scene::CameraPose& pose, bool agl, double fov_y_deg,
                      const mrbsp::TraversalOptions& traversal);
-  // Draws the prepared frame and waits for it; returns wall milliseconds.
+  // Draws the prepared frame (and waits for it); returns wall milliseconds.
   double draw();
   // The slide prepare() would make for a camera at `pose`, without a frame (terravol fly
   // --resume makes the slides of the frames it skips). Returns whether the window moved.
@@ -153,6 +160,9 @@ class SceneRenderer {
   const SlideFigures& last_slide() const { return last_slide_; }
 
   std::vector<std::uint8_t> rgb() const;  // the last image: width * height * 3 bytes, top row first
+  scene::Engine engine() const { return options_.engine; }
+  // With scene::Engine::kTiler: the tiler and its last frame's figures (else std::logic_error).
+  const TiledRenderer& tiled() const;
 
   // The point under pixel (x, y) of the last frame (x from the left, y from the bottom: VTK's
   // event positions), on the window's terrain or on the nearest isosurface, slice or object in
@@ -166,7 +176,8 @@ class SceneRenderer {
   const io::Mosaic& mosaic() const { return mosaic_; }
   const io::SceneFrame& frame() const { return scene_->frame(); }
   const scene::TerrainScene& terrain() const { return *scene_; }
-  TerrainRenderer& renderer() { return *renderer_; }
+  // The VTK renderer (std::logic_error with scene::Engine::kTiler, which has none).
+  TerrainRenderer& renderer();
   const mrbsp::Camera& camera() const { return camera_; }
   const mrbsp::Frame& last_frame() const { return frame_; }
   const scene::MergeFigures& merge_figures() const { return volumes_.figures(); }
@@ -233,7 +244,10 @@ class SceneRenderer {
   scene::TerrainShading lattice_;
   scene::VolumeLayer volumes_;
   scene::ObjectLayer objects_;
-  std::unique_ptr<TerrainRenderer> renderer_;
+  std::unique_ptr<TerrainRenderer> renderer_;  // kVtk
+  std::unique_ptr<TiledRenderer> tiled_;       // kTiler
+  std::array<scene::Rgb, 2> sky_{};            // kTiler: the background of the prepared frame, bottom and top
+  double far_plane_ = 0;                       // kTiler: of the prepared frame
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
   density::RefineOptions density_options_;

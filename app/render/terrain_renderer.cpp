@@ -615,28 +615,30 @@ void TerrainRenderer::set_labels(const std::vector<scene::MarkerLabel>& labels) 
   }
 }
 
-void TerrainRenderer::set_legend(const scene::Legend& legend) {
-  legend_card_.reset();
-  legend_cache_ = {};
-  if (!legend.empty()) {
-    LegendCard card;
-    card.title = legend.title;
-    card.subtitle = legend.subtitle;
-    if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
-    card.lo = legend.lo;
-    card.hi = legend.hi;
-    // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
-    card.entries_title = legend.categories.empty() ? "isosurfaces"
-                         : legend.levels.empty()   ? legend.categories_title
-                                                   : legend.categories_title + ", isosurfaces";
-    for (const scene::LegendLevel& l : legend.categories) {
-      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
-    }
-    for (const scene::LegendLevel& l : legend.levels) {
-      card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
-    }
-    legend_card_ = std::move(card);
+std::optional<LegendCard> legend_card(const scene::Legend& legend) {
+  if (legend.empty()) return std::nullopt;
+  LegendCard card;
+  card.title = legend.title;
+  card.subtitle = legend.subtitle;
+  if (!legend.colormap.empty()) card.colormap = volume::colormap_by_name(legend.colormap);
+  card.lo = legend.lo;
+  card.hi = legend.hi;
+  // A categorical slice's swatches come first (it has no bar), then the isosurfaces'.
+  card.entries_title = legend.categories.empty() ? "isosurfaces"
+                       : legend.levels.empty()   ? legend.categories_title
+                                                 : legend.categories_title + ", isosurfaces";
+  for (const scene::LegendLevel& l : legend.categories) {
+    card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
   }
+  for (const scene::LegendLevel& l : legend.levels) {
+    card.entries.push_back({l.label, {l.color[0], l.color[1], l.color[2]}, l.value});
+  }
+  return card;
+}
+
+void TerrainRenderer::set_legend(const scene::Legend& legend) {
+  legend_cache_ = {};
+  legend_card_ = legend_card(legend);
   legend_actor_->SetVisibility(false);
 }
 

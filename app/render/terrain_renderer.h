@@ -87,6 +87,10 @@ void require_x_display(const std::string& who = "render");
 // own connection inside a running viewer left the viewer's X event loop polling a closed one.
 void use_shared_display(vtkRenderWindow* window, const std::string& who = "render");
 
+// The legend card of a volume layer's legend (the slice's map, each isosurface level marked on
+// it and given a swatch; a categorical slice's swatches first); none for an empty legend.
+std::optional<LegendCard> legend_card(const scene::Legend& legend);
+
 class TerrainRenderer {
  public:
   // positions: TerrainTree::positions(); shading: per vertex, the same count (vertex_shading).

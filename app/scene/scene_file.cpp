@@ -109,7 +109,11 @@ density::DensitySpec density_of(const Reader& r, const json& j, const std::strin
   return d;
 }
 
-VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& base) {
+// `isosurfaces_before`: how many isosurfaces the volumes before this one have (an isosurface
+// without a colour takes the palette's colour of its place among all of the file's, so that
+// the surfaces of different volumes differ); counted on.
+VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& base,
+                     std::size_t& isosurfaces_before) {
   r.only_keys(j, where, {"file", "field", "frame", "visible", "isosurfaces", "slices", "density"});
   if (!j.contains("file")) r.fail(where, "missing \"file\"");
   VolumeSpec v;
@@ -131,7 +135,7 @@ VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, c
     if (!j[list].is_array()) r.fail(w, "expected a list");
     for (std::size_t k = 0; k < j[list].size(); ++k) {
       if (list[0] == 'i') {
-        v.isosurfaces.push_back(iso_of(r, j[list][k], Reader::at(w, k), k));
+        v.isosurfaces.push_back(iso_of(r, j[list][k], Reader::at(w, k), isosurfaces_before++));
       } else {
         v.slices.push_back(slice_of(r, j[list][k], Reader::at(w, k)));
       }
@@ -253,8 +257,9 @@ SceneSpec parse_scene_json(const json& doc, const std::filesystem::path& base, c
   }
   if (doc.contains("volumes")) {
     if (!doc["volumes"].is_array()) r.fail("volumes", "expected a list");
+    std::size_t isosurfaces = 0;
     for (std::size_t k = 0; k < doc["volumes"].size(); ++k) {
-      s.volumes.push_back(volume_of(r, doc["volumes"][k], Reader::at("volumes", k), base));
+      s.volumes.push_back(volume_of(r, doc["volumes"][k], Reader::at("volumes", k), base, isosurfaces));
     }
   }
   if (doc.contains("objects")) {

@@ -80,6 +80,22 @@ bool parse_on_off(std::string_view option, std::string_view text) {
   throw std::invalid_argument(quote(option, text) + "expected on or off");
 }
 
+Engine parse_engine(std::string_view text) {
+  if (text == "vtk") return Engine::kVtk;
+  if (text == "tiler") return Engine::kTiler;
+  throw std::invalid_argument(quote("--renderer", text) + "unknown renderer (expected vtk or tiler)");
+}
+
+const char* engine_name(Engine engine) { return engine == Engine::kTiler ? "tiler" : "vtk"; }
+
+int parse_aa(std::string_view text) {
+  if (text == "1") return 1;
+  if (text == "2") return 2;
+  if (text == "4") return 4;
+  if (text == "8") return 8;
+  throw std::invalid_argument(quote("--aa", text) + "expected 1, 2, 4 or 8 (samples per pixel per axis)");
+}
+
 mrbsp::Coherence parse_coherence(std::string_view text) {
   if (text == "off") return mrbsp::Coherence::kOff;
   if (text == "update") return mrbsp::Coherence::kUpdate;

@@ -30,6 +30,10 @@ enum class DrawOrder : std::uint8_t {
   kSort,  // vtkDepthSortPolyData (cells by centre, back to front), then plain alpha blending
 };
 
+// What draws an export (render, fly --renderer): VTK, or the coverage-mask tiler (tiler/,
+// Greene 1996: the tree's front-to-back order tiled in software with aa x aa samples a pixel).
+enum class Engine : std::uint8_t { kVtk, kTiler };
+
 // Isosurfaces are reduced to this many triangles each before merging (0: all); slices never.
 inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
 
@@ -109,5 +113,8 @@ const char* tint_name(Tint tint);                      // the inverse of parse_t
 bool parse_on_off(std::string_view option, std::string_view text);  // on | off
 mrbsp::Coherence parse_coherence(std::string_view text);             // off | update | conservative
 const char* coherence_name(mrbsp::Coherence coherence);              // the inverse of parse_coherence
+Engine parse_engine(std::string_view text);            // --renderer: vtk | tiler
+const char* engine_name(Engine engine);                // the inverse of parse_engine
+int parse_aa(std::string_view text);                   // --aa: 1 | 2 | 4 | 8 (samples per pixel per axis)
 
 }  // namespace terravol::app::scene

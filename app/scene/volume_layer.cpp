@@ -377,13 +377,25 @@ Legend VolumeLayer::legend() const {
                     d.colormap.c_str());
       legend.subtitle = b;
     }
+    break;
+  }
+  // The isosurfaces of every visible volume of the same field: named by their file when more
+  // than one volume has any.
+  const auto same_field = [&](const Loaded& v) {
+    return v.spec.visible && v.data.name + (v.data.units.empty() ? "" : " (" + v.data.units + ")") == legend.title;
+  };
+  const auto with_levels = std::count_if(volumes_.begin(), volumes_.end(), [&](const auto& v) {
+    return same_field(*v) && !v->spec.isosurfaces.empty();
+  });
+  for (const auto& v : volumes_) {
+    if (!same_field(*v)) continue;
     for (const auto& iso : v->spec.isosurfaces) {
       char b[48];
       std::snprintf(b, sizeof b, "%g%s%s", static_cast<double>(iso.value), v->data.units.empty() ? "" : " ",
                     v->data.units.c_str());
-      legend.levels.push_back({b, {iso.color.r, iso.color.g, iso.color.b}, iso.value});
+      const std::string label = with_levels > 1 ? v->spec.file.stem().string() + ": " + b : std::string(b);
+      legend.levels.push_back({label, {iso.color.r, iso.color.g, iso.color.b}, iso.value});
     }
-    break;
   }
   return legend;
 }

@@ -40,8 +40,10 @@ struct LegendLevel {
 };
 
 // The colour legend of the volumes (the renderer draws it as a card, app/render/legend_image.h):
-// the field, the first slice's colour map over [lo, hi] (named in the subtitle) and every
-// isosurface level. Empty (no map, no levels): no legend.
+// the field of the first visible volume that draws anything, its first slice's colour map over
+// [lo, hi] (named in the subtitle), and the isosurface levels of every visible volume of that
+// field (each label preceded by the volume's file name when more than one volume has levels).
+// Empty (no map, no levels): no legend.
 struct Legend {
   std::string title;     // "path_loss_db (dB)"
   std::string subtitle;  // "slice 300 m above ground: viridis"; empty without a slice

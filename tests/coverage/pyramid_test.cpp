@@ -394,6 +394,122 @@ TEST(Cover, TriangulatedGridWithoutMarginClaimsEveryCentreExactlyOnce) {
   EXPECT_EQ(all.check_invariants(), "");
 }
 
+// The pixels of `masks` (runs of tiles) as a bitmap; fails (returns false) when a pixel is
+// reported twice, a mask is empty, a run longer than one tile is not of whole tiles, or a pixel
+// lies outside the viewport.
+bool reported_bitmap(const std::vector<TileMask>& masks, Bitmap& out, std::string& why) {
+  for (const TileMask& t : masks) {
+    if (t.mask == 0 || t.run < 1 || (t.run > 1 && t.mask != ~std::uint64_t{0})) {
+      why = "an empty mask or a bad run at tile (" + std::to_string(t.tx) + ", " + std::to_string(t.ty) + ")";
+      return false;
+    }
+    for (int k = 0; k < t.run; ++k) {
+      for (int bit = 0; bit < 64; ++bit) {
+        if (!((t.mask >> bit) & 1)) continue;
+        const int x = 8 * (t.tx + k) + (bit & 7), y = 8 * t.ty + (bit >> 3);
+        if (x < 0 || y < 0 || x >= out.w || y >= out.h) {
+          why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") outside the viewport";
+          return false;
+        }
+        if (out.at(x, y)) {
+          why = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") reported twice";
+          return false;
+        }
+        out.at(x, y) = 1;
+      }
+    }
+  }
+  return true;
+}
+
+// The pixels of `all` not in `before`.
+Bitmap less(Bitmap all, const Bitmap& before) {
+  for (std::size_t i = 0; i < all.bits.size(); ++i) all.bits[i] = all.bits[i] && !before.bits[i];
+  return all;
+}
+
+Bitmap covered_bitmap(const Pyramid& p) {
+  Bitmap b(p.width(), p.height());
+  for (int y = 0; y < p.height(); ++y)
+    for (int x = 0; x < p.width(); ++x) b.at(x, y) = p.covered(x, y) ? 1 : 0;
+  return b;
+}
+
+// Greene's W masks down to the finest level: a recording cover() reports exactly the pixels it
+// newly covers (brute force less what was covered before), each once, over sequences of every
+// kind of polygon, and covers just what the plain cover() covers.
+TEST(CoverReporting, ReportsExactlyThePixelsEachCoverNewlyClaims) {
+  std::mt19937 rng(4242);
+  const int sizes[][2] = {{157, 93}, {600, 520}, {64, 64}, {9, 300}};
+  for (const auto& wh : sizes) {
+    const int w = wh[0], h = wh[1];
+    Pyramid p(w, h), plain(w, h);
+    for (int step = 0; step < 120; ++step) {
+      const Poly poly = random_polygon(rng, w, h);
+      const double margin = step % 3 == 0 ? 0.0 : random_margin(rng);
+      const Bitmap before = covered_bitmap(p);
+      std::vector<TileMask> claimed;
+      p.cover(poly, margin, claimed);
+      plain.cover(poly, margin);
+      Bitmap got(w, h);
+      std::string why;
+      ASSERT_TRUE(reported_bitmap(claimed, got, why)) << w << "x" << h << " step " << step << ": " << why;
+      const Bitmap want = less(claimed_ref(poly, margin, w, h), before);
+      ASSERT_EQ(got.bits, want.bits) << w << "x" << h << " step " << step;
+      ASSERT_EQ(differences(p, covered_bitmap(plain)), "") << step;
+      ASSERT_EQ(p.check_invariants(), "") << step;
+    }
+  }
+}
+
+// vacant(): the pixels a cover would claim now, reported without covering them: the pyramid's
+// pixels and triage masks are the same afterwards, whatever was covered before.
+TEST(CoverReporting, VacantReportsWhatCoverWouldClaimAndChangesNothing) {
+  std::mt19937 rng(99);
+  const int sizes[][2] = {{1280, 720}, {130, 77}, {513, 70}};
+  for (const auto& wh : sizes) {
+    const int w = wh[0], h = wh[1];
+    Pyramid p(w, h);
+    for (int step = 0; step < 60; ++step) {
+      const Poly poly = random_polygon(rng, w, h);
+      const double margin = step % 2 == 0 ? 0.0 : random_margin(rng);
+      const Bitmap before = covered_bitmap(p);
+      std::vector<TileMask> shown;
+      p.vacant(poly, margin, shown);
+      Bitmap got(w, h);
+      std::string why;
+      ASSERT_TRUE(reported_bitmap(shown, got, why)) << step << ": " << why;
+      ASSERT_EQ(differences(p, before), "") << "vacant() changed the pyramid at step " << step;
+      ASSERT_EQ(p.check_invariants(), "") << step;
+      const Bitmap want = less(claimed_ref(poly, margin, w, h), before);
+      ASSERT_EQ(got.bits, want.bits) << w << "x" << h << " step " << step;
+      // Then cover it (most of the time), so that later queries meet partial coverage.
+      if (step % 4 != 3) {
+        std::vector<TileMask> claimed;
+        p.cover(poly, margin, claimed);
+        Bitmap again(w, h);
+        ASSERT_TRUE(reported_bitmap(claimed, again, why)) << why;
+        ASSERT_EQ(again.bits, got.bits) << "cover claimed other pixels than vacant reported, step " << step;
+      }
+    }
+  }
+}
+
+// A mesh at margin 0 front to back: the reports of all its triangles partition the viewport.
+TEST(CoverReporting, TriangulatedGridReportsEveryPixelExactlyOnce) {
+  std::mt19937 rng(8);
+  const int w = 300, h = 170;
+  const Mesh mesh = grid_mesh(rng, w, h, 11, 7);
+  Pyramid p(w, h);
+  std::vector<TileMask> claimed;
+  for (const Poly& t : mesh.triangles) p.cover(t, 0.0, claimed);
+  Bitmap got(w, h);
+  std::string why;
+  ASSERT_TRUE(reported_bitmap(claimed, got, why)) << why;
+  EXPECT_EQ(got.count(), static_cast<std::size_t>(w) * h);
+  EXPECT_TRUE(p.full());
+}
+
 TEST(Cover, ClearEmptiesThePyramidAndResetsTheCounters) {
   Pyramid p(100, 60);
   p.cover(rect(-5, -5, 200, 200), 0.0);

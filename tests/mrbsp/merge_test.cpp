@@ -27,10 +27,13 @@ struct Soup : test::TriangleSoup {
   }
 };
 
-// With `in_planes`, two more lie exactly in split planes; the area tests leave them out, since
-// the brute-force reference counts a polygon on a boundary in both regions it bounds.
-Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
-  std::uniform_real_distribution<double> xy(-100.0, 1700.0), z(-50.0, 500.0), small(-150.0, 150.0);
+// `count` triangles with corners in [xy0, xy1]^2 x [z0, z1], every second one big (corners
+// anywhere there) and the others small (within `small` of their first corner).
+struct SoupExtent {
+  double xy0, xy1, z0, z1, small;
+};
+Soup random_triangles(std::mt19937& rng, int count, const SoupExtent& e) {
+  std::uniform_real_distribution<double> xy(e.xy0, e.xy1), z(e.z0, e.z1), small(-e.small, e.small);
   Soup s;
   for (int k = 0; k < count; ++k) {
     const glm::dvec3 a(xy(rng), xy(rng), z(rng));
@@ -40,6 +43,14 @@ Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
       s.add(a, {xy(rng), xy(rng), z(rng)}, {xy(rng), xy(rng), z(rng)});
     }
   }
+  return s;
+}
+
+// Over the 16-cell test window. With `in_planes`, two more lie exactly in split planes; the
+// area tests leave them out, since the brute-force reference counts a polygon on a boundary in
+// both regions it bounds.
+Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
+  Soup s = random_triangles(rng, count, {-100.0, 1700.0, -50.0, 500.0, 150.0});
   if (in_planes) {
     s.add({800.0, 100.0, 0.0}, {800.0, 900.0, 50.0}, {800.0, 500.0, 450.0});   // in the root plane
     s.add({300.0, 400.0, 20.0}, {1200.0, 400.0, 30.0}, {700.0, 400.0, 380.0});  // in a y plane
@@ -170,17 +181,7 @@ TEST(Merge, SlidingMergesThePolygonsAgainIntoTheMovedWindow) {
 // Triangles over the 64 x 64-sample terrain of SlidingTerrain (6.3 km): big and small ones,
 // through its volume.
 Soup soup_over_sliding_terrain(std::mt19937& rng, int count) {
-  std::uniform_real_distribution<double> xy(-150.0, 3000.0), z(-50.0, 450.0), small(-200.0, 200.0);
-  Soup s;
-  for (int k = 0; k < count; ++k) {
-    const glm::dvec3 a(xy(rng), xy(rng), z(rng));
-    if (k % 2) {
-      s.add(a, a + glm::dvec3(small(rng), small(rng), small(rng)), a + glm::dvec3(small(rng), small(rng), small(rng)));
-    } else {
-      s.add(a, {xy(rng), xy(rng), z(rng)}, {xy(rng), xy(rng), z(rng)});
-    }
-  }
-  return s;
+  return random_triangles(rng, count, {-150.0, 3000.0, -50.0, 450.0, 200.0});
 }
 
 // A slide by whole level-0 cells over the same terrain keeps the slots and pieces of the cells
@@ -194,7 +195,7 @@ TEST(Merge, ASlideByWholeCellsKeepsWhatStaysAndDrawsWhatAFreshMergeDraws) {
   const Soup soup = soup_over_sliding_terrain(rng, 60);
   TerrainTree slid(terrain.window_at(0, 0).view(), 3);  // level 0: 4 x 4 cells of 4 x 4 samples
   slid.merge(soup.v, soup.c, soup.t);
-  const int walk[][2] = {{8, 4}, {4, 16}, {16, 16}, {8, 8}, {12, 4}};
+  const int walk[][2] = {{8, 4}, {4, 16}, {16, 16}, {8, 8}, {12, 4}, {12, 12}, {12, 12}};
   for (const auto& at : walk) {
     const TestWindow w = terrain.window_at(at[0], at[1]);
     slid.slide(w.view());

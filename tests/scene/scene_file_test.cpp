@@ -1,5 +1,7 @@
 // The scene file: what it may say, how paths resolve, and one-line errors for what it may not.
 #include <gtest/gtest.h>
+
+#include "volume/geometry.h"
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -64,6 +66,20 @@ TEST(SceneFile, IsosurfacesWithoutAColourGetDistinctOnes) {
       json::parse(R"({"volumes": [{"file": "a.vdb", "isosurfaces": [{"value": 100}, {"value": 120}]}]})"), "/b", "s");
   EXPECT_NE(s.volumes[0].isosurfaces[0].color, s.volumes[0].isosurfaces[1].color);
   EXPECT_DOUBLE_EQ(s.volumes[0].isosurfaces[0].opacity, 0.5);
+}
+
+// Across volumes too: the palette follows an isosurface's place among all of the file's, so
+// two transmitters' volumes do not draw their surfaces in the same two colours.
+TEST(SceneFile, IsosurfacesOfDifferentVolumesWithoutAColourDiffer) {
+  const SceneSpec s = parse_scene_json(json::parse(R"({"volumes": [
+      {"file": "a.vdb", "isosurfaces": [{"value": 100}, {"value": 120}]},
+      {"file": "b.vdb", "isosurfaces": [{"value": 110, "color": [1, 2, 3]}, {"value": 130}]}]})"),
+                                       "/b", "s");
+  const std::vector<glm::u8vec3> colours{s.volumes[0].isosurfaces[0].color, s.volumes[0].isosurfaces[1].color,
+                                         s.volumes[1].isosurfaces[0].color, s.volumes[1].isosurfaces[1].color};
+  for (std::size_t a = 0; a < colours.size(); ++a)
+    for (std::size_t b = a + 1; b < colours.size(); ++b) EXPECT_NE(colours[a], colours[b]) << a << " " << b;
+  EXPECT_EQ(colours[3], volume::default_isosurface_color(3));
 }
 
 TEST(SceneFile, RenderStyleKeysAreRead) {

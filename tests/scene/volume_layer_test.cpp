@@ -69,5 +69,34 @@ TEST(VolumeLayerLegend, CategoricalSliceWithoutTransmittersCountsTheRange) {
   EXPECT_EQ(l.categories[2].color, (Rgb{0x2c, 0xa0, 0x2c}));
 }
 
+// Two volumes of one field, each with isosurfaces: the legend lists all of them, each named by
+// its volume's file; a hidden volume's are left out.
+TEST(VolumeLayerLegend, IsosurfacesOfEveryVisibleVolumeOfTheFieldAreListedByFile) {
+  const test::TempDir dir;
+  volume::Volume v = index_volume();
+  v.name = "path_loss_db";
+  v.units = "dB";
+  std::vector<VolumeSpec> specs;
+  for (const char* name : {"west.vdb", "east.vdb", "hidden.vdb"}) {
+    volume::write_vdb(dir.path() / name, {&v}, true);
+    VolumeSpec spec;
+    spec.file = dir.path() / name;
+    volume::IsoSpec iso;
+    iso.value = 1.5f;
+    spec.isosurfaces = {iso};
+    spec.visible = std::string(name) != "hidden.vdb";
+    specs.push_back(spec);
+  }
+  specs[1].isosurfaces.push_back(specs[1].isosurfaces.front());
+  specs[1].isosurfaces.back().value = 2.5f;
+  const io::Mosaic mosaic = io::Mosaic::open({std::string(TERRAVOL_SOURCE_DIR) + "/data/dem/N45E006.hgt"});
+  const Legend l = VolumeLayer(specs, mosaic, io::SceneFrame(45.515, 6.52)).legend();
+  EXPECT_EQ(l.title, "path_loss_db (dB)");
+  ASSERT_EQ(l.levels.size(), 3u);
+  EXPECT_EQ(l.levels[0].label, "west: 1.5 dB");
+  EXPECT_EQ(l.levels[1].label, "east: 1.5 dB");
+  EXPECT_EQ(l.levels[2].label, "east: 2.5 dB");
+}
+
 }  // namespace
 }  // namespace terravol::app::scene

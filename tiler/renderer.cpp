@@ -1,0 +1,843 @@
+// Hierarchical polygon tiling with coverage masks, as an antialiased renderer: N. Greene,
+// "Hierarchical Polygon Tiling with Coverage Masks", SIGGRAPH 1996.
+//  - Section 3.1 / listing 1 and section 4.1 (the coverage pyramid): each triangle, nearest
+//    first, is tiled into a pyramid whose finest level holds one bit per sub-sample and whose
+//    levels above hold triage masks; only vacant cells the triangle reaches are visited, and a
+//    covered sample is never written again. coverage::Pyramid does the tiling, at sample
+//    resolution: with aa = 8 its finest tiles are exactly the paper's 8x8 one-bit masks per
+//    pixel (figure 2: "a four-level pyramid of 8x8 masks corresponds to a 512x512 image with
+//    8x8 oversampling"); with aa = 4, 2, 1 a tile holds 2x2, 4x4 or 8x8 pixels.
+//  - Section 3.1, "evaluate shading and update accumulation buffer": the W masks (newly covered
+//    samples) come back from the pyramid tile by tile, whole cells as runs of tiles
+//    (Pyramid::cover with a report), and the
+//    samples are shaded and box-filtered into their pixel's accumulation, A-buffer style
+//    (section 2.2: "a single shading value is computed, weighted by the bit count of its
+//    mask"): one colour per fragment, evaluated at the centroid of the fragment's samples, so
+//    colours that are linear across a triangle (vertex colours, haze, the sky) are exact for
+//    the samples. Textured terrain is not linear in a pixel that spans several texels, so there
+//    the fragment is cut into blocks of samples shaded at their own centroids
+//    (Settings::texel_rate), down to every sample.
+//  - Section 4.3: the pyramid starts a triangle at the smallest enclosing cells and stops at
+//    once when they are covered (its bounding-box test). Section 4.4, box filtering: the
+//    accumulation buffer is in floats, one sum per pixel, divided by aa^2 at the end.
+//  - Section 5.2 (hierarchical object-space culling, test-only tiling of node boxes) is the
+//    traversal's: mrbsp's occlusion pass, which the caller runs on a camera at sample
+//    resolution (app/render/tiled_renderer.h) so that it culls only nodes whose every sample is
+//    covered; this renderer sees the triangles the traversal kept.
+// Where this departs from the paper:
+//  - Translucent triangles (isosurfaces, slices) are not tiled into the pyramid: the samples of
+//    theirs that are still vacant (Pyramid::vacant) get colour times alpha times the
+//    transmittance of what lies in front of them, and that transmittance is scaled by 1 - alpha
+//    (front-to-back "under" compositing, exact in the tree's exact order). Transmittance is kept
+//    per pixel, uniform while every translucent triangle in front covered all of the pixel's
+//    open samples, else as a short list of classes (a sample mask and its transmittance) split
+//    as translucent edges cross the pixel.
+//  - The image is cut into horizontal bands, each with its own pyramid, tiled in parallel
+//    (TBB); triangles are binned by the bands their projection reaches, in order.
+//  - Triangles are clipped at the near and far planes and at a guard band of 2^16 pixels
+//    around the viewport (the pyramid takes coordinates up to 2^24 samples); the clip point of
+//    an edge is computed from its inside end, so two triangles sharing a clipped edge agree.
+#include "tiler/renderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <glm/geometric.hpp>
+
+#include "coverage/pyramid.h"
+
+namespace terravol::tiler {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// CPU time of the calling thread, milliseconds.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+constexpr double kGuard = 65536.0;  // pixels beyond the viewport that a clipped polygon may reach
+constexpr int kMaxClipped = 3 + 6;  // a triangle clipped by six planes
+
+int popcount(std::uint64_t x) {
+  // Without -mpopcnt std::popcount is a library call; the usual SWAR count.
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
+}
+
+// Masks of a pixel's samples in the 8x8 layout of a tile: sample (sx, sy) is bit sy * 8 + sx,
+// the aa x aa samples of a pixel at the low corner (bits outside it are 0).
+constexpr std::uint64_t rect_mask(int x0, int w, int y0, int h) {
+  const std::uint64_t cols = ((std::uint64_t{1} << w) - 1) << x0;
+  std::uint64_t m = 0;
+  for (int r = y0; r < y0 + h; ++r) m |= cols << (8 * r);
+  return m;
+}
+// Samples whose x (y) has bit k set, for centroids: the sum of x over a mask is
+// sum_k 2^k popcount(m & X_k).
+constexpr std::uint64_t kX1 = 0xAAAAAAAAAAAAAAAAull, kX2 = 0xCCCCCCCCCCCCCCCCull, kX4 = 0xF0F0F0F0F0F0F0F0ull;
+constexpr std::uint64_t kY1 = 0xFF00FF00FF00FF00ull, kY2 = 0xFFFF0000FFFF0000ull, kY4 = 0xFFFFFFFF00000000ull;
+
+// The centroid of a non-empty mask's samples, in samples from the pixel's low corner (sample
+// centres at +0.5).
+glm::vec2 centroid(std::uint64_t m, int count) {
+  const int sx = popcount(m & kX1) + 2 * popcount(m & kX2) + 4 * popcount(m & kX4);
+  const int sy = popcount(m & kY1) + 2 * popcount(m & kY2) + 4 * popcount(m & kY4);
+  const float inv = 1.0f / static_cast<float>(count);
+  return {static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f};
+}
+
+int pow2_at_least(double v, int cap) {
+  int k = 1;
+  while (k < cap && k < v) k *= 2;
+  return k;
+}
+
+// Eye space: x right, y up, z the depth along the view axis (GL's clip w).
+struct Eye {
+  double x, y, z;
+};
+
+// The view as GL sees it (vtkCamera from mrbsp::Camera: app/render/vtk_camera.h).
+struct View {
+  glm::dvec3 eye, r, u, f;
+  double focal = 1, hw = 0, hh = 0, near = 1, far = 2;
+  Eye to_eye(const glm::vec3& p) const {
+    const glm::dvec3 d = glm::dvec3(p) - eye;
+    return {glm::dot(d, r), glm::dot(d, u), glm::dot(d, f)};
+  }
+  glm::dvec2 window(const Eye& e) const { return {hw + focal * e.x / e.z, hh + focal * e.y / e.z}; }
+  // The clip planes' values (inside where >= 0): near, far, and the guard band's four sides.
+  double plane(int k, const Eye& e) const {
+    switch (k) {
+      case 0: return e.z - near;
+      case 1: return far - e.z;
+      case 2: return (hw + kGuard) * e.z + focal * e.x;
+      case 3: return (hw + kGuard) * e.z - focal * e.x;
+      case 4: return (hh + kGuard) * e.z + focal * e.y;
+      default: return (hh + kGuard) * e.z - focal * e.y;
+    }
+  }
+};
+
+// The triangle's polygon in window coordinates (output pixels), clipped where it must be.
+// Returns the vertex count (0: nothing in view) and whether it was clipped.
+int window_polygon(const View& v, const std::array<Eye, 3>& tri, std::array<glm::dvec2, kMaxClipped>& out, bool& clipped) {
+  int outside_any = 0;
+  for (int k = 0; k < 6; ++k) {
+    int outside = 0;
+    for (const Eye& e : tri) outside += v.plane(k, e) < 0 ? 1 : 0;
+    if (outside == 3) return 0;
+    outside_any |= outside > 0 ? 1 << k : 0;
+  }
+  clipped = outside_any != 0;
+  if (!clipped) {
+    for (std::size_t i = 0; i < 3; ++i) out[i] = v.window(tri[i]);
+    return 3;
+  }
+  // Sutherland-Hodgman in eye space, plane by plane.
+  std::array<Eye, kMaxClipped> a{}, b{};
+  int n = 3;
+  std::copy(tri.begin(), tri.end(), a.begin());
+  for (int k = 0; k < 6; ++k) {
+    if (!(outside_any & (1 << k))) continue;
+    std::size_t m = 0;
+    for (int i = 0; i < n; ++i) {
+      const Eye& p = a[static_cast<std::size_t>(i)];
+      const Eye& q = a[static_cast<std::size_t>((i + 1) % n)];
+      const double dp = v.plane(k, p), dq = v.plane(k, q);
+      if (dp >= 0) b[m++] = p;
+      if ((dp >= 0) != (dq >= 0)) {
+        // From the inside end, so that both triangles of a shared edge get the same point.
+        const Eye& in = dp >= 0 ? p : q;
+        const Eye& out_end = dp >= 0 ? q : p;
+        const double d_in = dp >= 0 ? dp : dq, d_out = dp >= 0 ? dq : dp;
+        const double t = d_in / (d_in - d_out);
+        b[m++] = {in.x + (out_end.x - in.x) * t, in.y + (out_end.y - in.y) * t, in.z + (out_end.z - in.z) * t};
+      }
+    }
+    n = static_cast<int>(m);
+    if (n < 3) return 0;
+    std::swap(a, b);
+  }
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) out[i] = v.window(a[i]);
+  return n;
+}
+
+std::array<Eye, 3> eye_triangle(const View& v, std::span<const glm::vec3> positions, const std::uint32_t* idx) {
+  return {v.to_eye(positions[idx[0]]), v.to_eye(positions[idx[1]]), v.to_eye(positions[idx[2]])};
+}
+
+enum class Kind : std::uint8_t { kTextured, kWall, kMerged };
+
+// A colour, 0..255 per channel (r, g, b; the fourth lane unused): one SSE2 register where there
+// is SSE2 (every x86-64), four floats otherwise.
+#if defined(__SSE2__)
+struct Color {
+  __m128 v;
+  Color() : v(_mm_setzero_ps()) {}
+  explicit Color(__m128 x) : v(x) {}
+  Color(float r, float g, float b) : v(_mm_set_ps(0.0f, b, g, r)) {}
+  friend Color operator+(Color a, Color b) { return Color(_mm_add_ps(a.v, b.v)); }
+  friend Color operator-(Color a, Color b) { return Color(_mm_sub_ps(a.v, b.v)); }
+  friend Color operator*(Color a, float s) { return Color(_mm_mul_ps(a.v, _mm_set1_ps(s))); }
+  Color& operator+=(Color b) { return *this = *this + b; }
+  std::array<float, 4> lanes() const {
+    std::array<float, 4> f;
+    _mm_storeu_ps(f.data(), v);
+    return f;
+  }
+  // The RGBA bytes at p, as floats.
+  static Color bytes(const std::uint8_t* p) {
+    std::int32_t word;
+    std::memcpy(&word, p, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i x = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
+    return Color(_mm_cvtepi32_ps(x));
+  }
+};
+#else
+struct Color {
+  std::array<float, 4> c{0, 0, 0, 0};
+  Color() = default;
+  Color(float r, float g, float b) : c{r, g, b, 0.0f} {}
+  friend Color operator+(Color a, Color b) {
+    for (std::size_t k = 0; k < 4; ++k) a.c[k] += b.c[k];
+    return a;
+  }
+  friend Color operator-(Color a, Color b) {
+    for (std::size_t k = 0; k < 4; ++k) a.c[k] -= b.c[k];
+    return a;
+  }
+  friend Color operator*(Color a, float s) {
+    for (float& x : a.c) x *= s;
+    return a;
+  }
+  Color& operator+=(Color b) { return *this = *this + b; }
+  std::array<float, 4> lanes() const { return c; }
+  static Color bytes(const std::uint8_t* p) { return Color(p[0], p[1], p[2]); }
+};
+#endif
+
+// An affine function of window position, about the triangle's centre: at + a dx + b dy.
+struct Plane {
+  float a = 0, b = 0, at = 0;
+  float operator()(float dx, float dy) const { return at + a * dx + b * dy; }
+};
+
+// What a triangle is shaded with. Attributes are interpolated perspective-correctly by the
+// homogeneous barycentrics of the pixel ray (Olano and Greer 1997): with the vertices' eye
+// positions V0, V1, V2 and the ray direction D(x, y) = ((x - w/2) / f, (y - h/2) / f, 1), the
+// barycentrics are e_i / (e_0 + e_1 + e_2) for e_i = (V_j x V_k) . D, affine in (x, y); an
+// attribute is then (sum A_i e_i) / (sum e_i), the quotient of two planes: no clipping and no
+// determinant needed. The planes are set up in double precision about the triangle's centre
+// (x0, y0), scaled so that the denominator is 1 there, and evaluated in float.
+struct Shade {
+  Kind kind = Kind::kTextured;
+  bool translucent = false;
+  int kx = 1, ky = 1;        // shading blocks per pixel along x and y (textured)
+  float x0 = 0, y0 = 0;
+  Plane s;                   // sum e_i
+  std::array<Plane, 5> n;    // textured: u, v (texels), haze; wall: haze; merged: r, g, b, a (0..255), haze
+};
+
+// The lattice texture: bilinear between texel centres (whole texel coordinates), clamped to the
+// edge (GL's LINEAR filter with CLAMP_TO_EDGE).
+struct Texture {
+  const std::uint8_t* rgba = nullptr;
+  int side = 0;
+  Color at(float u, float v) const {
+    const float hi = static_cast<float>(side - 1);
+    u = std::clamp(u, 0.0f, hi);
+    v = std::clamp(v, 0.0f, hi);
+    const int i0 = std::min(static_cast<int>(u), std::max(side - 2, 0));
+    const int j0 = std::min(static_cast<int>(v), std::max(side - 2, 0));
+    const float fu = u - static_cast<float>(i0), fv = v - static_cast<float>(j0);
+    const std::size_t step = side > 1 ? 4 : 0, row = step * static_cast<std::size_t>(side);
+    const std::uint8_t* p = rgba + 4 * (static_cast<std::size_t>(j0) * static_cast<std::size_t>(side) + static_cast<std::size_t>(i0));
+    const Color c00 = Color::bytes(p), c10 = Color::bytes(p + step);
+    const Color c01 = Color::bytes(p + row), c11 = Color::bytes(p + row + step);
+    const Color b = c00 + (c10 - c00) * fu, t = c01 + (c11 - c01) * fu;
+    return b + (t - b) * fv;
+  }
+};
+
+// The colour (0..255) and opacity of a triangle at window point (x, y).
+struct Shader {
+  Texture texture;
+  Color wall;
+  Color haze;
+  bool hazy = false;
+  Color operator()(const Shade& sh, float x, float y, float& alpha) const {
+    const float dx = x - sh.x0, dy = y - sh.y0;
+    float S = sh.s(dx, dy);
+    if (!(S != 0.0f) || !std::isfinite(S)) S = 1.0f;  // a triangle seen edge-on: any point of it
+    const float inv = 1.0f / S;
+    Color c;
+    float h = 0;
+    alpha = 1.0f;
+    switch (sh.kind) {
+      case Kind::kTextured:
+        c = texture.at(sh.n[0](dx, dy) * inv, sh.n[1](dx, dy) * inv);
+        h = sh.n[2](dx, dy) * inv;
+        break;
+      case Kind::kWall:
+        c = wall;
+        h = sh.n[0](dx, dy) * inv;
+        break;
+      case Kind::kMerged:
+        c = Color(sh.n[0](dx, dy), sh.n[1](dx, dy), sh.n[2](dx, dy)) * inv;
+        alpha = std::clamp(sh.n[3](dx, dy) * inv * (1.0f / 255.0f), 0.0f, 1.0f);
+        h = sh.n[4](dx, dy) * inv;
+        break;
+    }
+    if (hazy) c += (haze - c) * h;
+    return c;
+  }
+};
+
+struct Class {
+  std::uint64_t mask;  // open samples with this transmittance
+  float t;
+  std::int32_t next;
+};
+
+// What a pixel accumulates (one 32-byte record, so that a fragment touches one cache line): the
+// colour summed over its samples (0..255 each), the transmittance of its open samples when it is
+// uniform, else the head of its transmittance classes (-1: uniform), the samples shaded.
+struct alignas(32) Pixel {
+  Color acc;
+  float t = 1.0f;
+  std::int32_t head = -1;
+  std::uint32_t count = 0;
+};
+
+}  // namespace
+
+struct Renderer::Impl {
+  // Per band and thread: the band's pyramid (one per band height: the last band may be
+  // shorter), the pyramid's reports, transmittance classes, polygon scratch, counters.
+  struct BandState {
+    std::vector<std::unique_ptr<coverage::Pyramid>> pyramids;
+    std::vector<coverage::TileMask> records;
+    std::vector<Class> classes;
+    std::vector<Pixel> pixels;  // the band's, rows from its first (bottom) one
+    std::vector<glm::dvec2> poly;
+    Stats stats;
+    coverage::Pyramid& pyramid(int w, int h) {
+      for (auto& p : pyramids)
+        if (p->width() == w && p->height() == h) {
+          p->clear();
+          return *p;
+        }
+      pyramids.push_back(std::make_unique<coverage::Pyramid>(w, h));
+      return *pyramids.back();
+    }
+  };
+  tbb::enumerable_thread_specific<BandState> states;
+  // Per triangle of the frame: the bands its projection reaches (first > last: none).
+  std::vector<std::int32_t> band_first, band_last;
+  std::vector<std::uint32_t> band_start, band_items;  // triangles of band b: items [start[b], start[b+1])
+};
+
+namespace {
+
+// A band's pixels being accumulated: the colour sums, transmittance and sample counts of the
+// pixels of one band (rows from the bottom), and its transmittance classes.
+struct Accumulator {
+  Pixel* px;
+  std::vector<Class>& classes;
+  Stats& stats;
+  std::uint64_t full;  // a pixel's samples
+
+  // Adds colour c times weight to pixel p for the samples of mask (all open), each weighted by
+  // its transmittance.
+  void add(std::size_t p, std::uint64_t mask, int count, Color c, float weight) {
+    float w = 0;
+    Pixel& q = px[p];
+    const std::int32_t h0 = q.head;
+    if (h0 < 0) {
+      w = static_cast<float>(count) * q.t;
+    } else {
+      for (std::int32_t k = h0; k >= 0; k = classes[static_cast<std::size_t>(k)].next) {
+        const Class& cl = classes[static_cast<std::size_t>(k)];
+        const std::uint64_t i = cl.mask & mask;
+        if (i) w += static_cast<float>(popcount(i)) * cl.t;
+      }
+    }
+    q.acc += c * (w * weight);
+  }
+
+  // An opaque fragment's newly covered samples: shaded once or block by block.
+  void opaque(std::size_t p, std::uint64_t mask, int count, Color c) {
+    px[p].count += static_cast<std::uint32_t>(count);
+    stats.samples_covered += static_cast<std::uint64_t>(count);
+    add(p, mask, count, c, 1.0f);
+  }
+
+  // A translucent fragment: colour c with opacity alpha over the samples of mask (all open);
+  // the pixel's covered samples are `covered`.
+  void translucent(std::size_t p, std::uint64_t mask, int count, std::uint64_t covered, Color c, float alpha) {
+    add(p, mask, count, c, alpha);
+    const float keep = 1.0f - alpha;
+    std::int32_t& h0 = px[p].head;
+    if (h0 < 0) {
+      const std::uint64_t rest = full & ~mask & ~covered;
+      if (!rest) {
+        px[p].t *= keep;
+        return;
+      }
+      const float t = px[p].t;
+      classes.push_back({rest, t, -1});
+      classes.push_back({mask, t * keep, static_cast<std::int32_t>(classes.size()) - 1});
+      h0 = static_cast<std::int32_t>(classes.size()) - 1;
+      ++stats.class_splits;
+      return;
+    }
+    for (std::int32_t k = h0; k >= 0;) {
+      Class& cl = classes[static_cast<std::size_t>(k)];
+      const std::int32_t next = cl.next;
+      const std::uint64_t i = cl.mask & mask;
+      if (i) {
+        const std::uint64_t rest = cl.mask & ~mask & ~covered;
+        if (!rest) {
+          cl.mask = i;
+          cl.t *= keep;
+        } else {
+          cl.mask = rest;
+          const float t = cl.t * keep;
+          classes.push_back({i, t, h0});  // at the head: not met again in this loop
+          h0 = static_cast<std::int32_t>(classes.size()) - 1;
+          ++stats.class_splits;
+        }
+      }
+      k = next;
+    }
+    // Classes of equal transmittance join (the two triangles of a translucent quad split the
+    // pixels on their shared edge, and the second one makes the halves equal again), classes
+    // of covered samples go, and one class left is the uniform case again.
+    const std::uint64_t open = full & ~covered;
+    std::int32_t* link = &h0;
+    while (*link >= 0) {
+      Class& cl = classes[static_cast<std::size_t>(*link)];
+      cl.mask &= open;
+      if (!cl.mask) {
+        *link = cl.next;
+        continue;
+      }
+      for (std::int32_t* other = &cl.next; *other >= 0;) {
+        Class& o = classes[static_cast<std::size_t>(*other)];
+        if (o.t == cl.t) {
+          cl.mask |= o.mask & open;
+          *other = o.next;
+        } else {
+          other = &o.next;
+        }
+      }
+      link = &cl.next;
+    }
+    // (mask is open and not empty, so some class is left.)
+    if (classes[static_cast<std::size_t>(h0)].next < 0) {
+      px[p].t = classes[static_cast<std::size_t>(h0)].t;
+      h0 = -1;
+    }
+  }
+};
+
+}  // namespace
+
+Renderer::Renderer(const Settings& settings) : settings_(settings), impl_(std::make_unique<Impl>()) {
+  const Settings& s = settings;
+  if (s.aa != 1 && s.aa != 2 && s.aa != 4 && s.aa != 8) {
+    throw std::invalid_argument("tiler::Renderer: aa " + std::to_string(s.aa) + " is not 1, 2, 4 or 8");
+  }
+  const int limit = coverage::kMaxViewport / s.aa;
+  if (s.width < 1 || s.height < 1 || s.width > limit || s.height > limit) {
+    throw std::invalid_argument("tiler::Renderer: " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                                " outside 1.." + std::to_string(limit) + " pixels per side at aa " + std::to_string(s.aa));
+  }
+  if (!(s.texel_rate >= 0.0) || !std::isfinite(s.texel_rate)) {
+    throw std::invalid_argument("tiler::Renderer: texel_rate must be a finite number >= 0");
+  }
+  if (s.band_rows < 1) throw std::invalid_argument("tiler::Renderer: band_rows must be >= 1");
+  if (s.threads < 0) throw std::invalid_argument("tiler::Renderer: threads must be >= 0");
+  const std::size_t pixels = static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height);
+  rgb_.assign(pixels * 3, 0);
+  counts_.assign(pixels, 0);
+}
+
+Renderer::~Renderer() = default;
+
+namespace {
+
+// The shading of triangle idx (its eye-space vertices tri, its clipped window polygon poly).
+Shade setup_shade(const View& view, const SceneColors& colors, const Look& look, double texel_rate, int aa,
+                  const std::uint32_t* idx, const std::array<Eye, 3>& tri, const std::array<glm::dvec2, kMaxClipped>& poly,
+                  int n) {
+  const std::size_t side = static_cast<std::size_t>(colors.lattice_side), lattice = side * side;
+  Shade sh;
+  const std::uint32_t v0 = idx[0];
+  sh.kind = v0 < lattice ? Kind::kTextured : v0 < colors.merged_base ? Kind::kWall : Kind::kMerged;
+  std::array<double, 3> haze{0, 0, 0};
+  if (look.haze_distance > 0.0) {
+    for (std::size_t i = 0; i < 3; ++i) haze[i] = 0.85 * (1.0 - std::exp(-tri[i].z / look.haze_distance));
+  }
+  std::array<std::array<double, 5>, 3> attr{};  // per vertex
+  std::size_t n_attr = 0;
+  if (sh.kind == Kind::kTextured) {
+    n_attr = 3;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t v = idx[i];
+      const bool on = v < lattice;  // (a textured triangle has lattice vertices only)
+      attr[i] = {on ? static_cast<double>(v % side) : 0.0, on ? static_cast<double>(v / side) : 0.0, haze[i], 0, 0};
+    }
+  } else if (sh.kind == Kind::kWall) {
+    n_attr = 1;
+    for (std::size_t i = 0; i < 3; ++i) attr[i][0] = haze[i];
+  } else {
+    n_attr = 5;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t v = idx[i];
+      const glm::u8vec4 c = v >= colors.merged_base ? colors.merged_colors[v - colors.merged_base] : colors.wall_color;
+      attr[i] = {static_cast<double>(c.r), static_cast<double>(c.g), static_cast<double>(c.b), static_cast<double>(c.a), haze[i]};
+      sh.translucent = sh.translucent || c.a < 255;
+    }
+  }
+  // The centre: the polygon's vertex mean.
+  glm::dvec2 centre(0.0);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) centre += poly[i];
+  centre /= static_cast<double>(n);
+  // e_i = (V_j x V_k) . D, D = ((x - hw) / f, (y - hh) / f, 1): gradient and value at the centre.
+  struct Affine {
+    double a = 0, b = 0, at = 0;
+  };
+  Affine s;
+  std::array<Affine, 5> num;
+  const double dx = (centre.x - view.hw) / view.focal, dy = (centre.y - view.hh) / view.focal;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Eye& a = tri[(i + 1) % 3];
+    const Eye& b = tri[(i + 2) % 3];
+    const double cx = a.y * b.z - a.z * b.y, cy = a.z * b.x - a.x * b.z, cz = a.x * b.y - a.y * b.x;
+    const Affine e{cx / view.focal, cy / view.focal, cx * dx + cy * dy + cz};
+    s.a += e.a;
+    s.b += e.b;
+    s.at += e.at;
+    for (std::size_t k = 0; k < n_attr; ++k) {
+      num[k].a += attr[i][k] * e.a;
+      num[k].b += attr[i][k] * e.b;
+      num[k].at += attr[i][k] * e.at;
+    }
+  }
+  const double scale = s.at != 0.0 && std::isfinite(s.at) ? 1.0 / s.at : 1.0;
+  sh.x0 = static_cast<float>(centre.x);
+  sh.y0 = static_cast<float>(centre.y);
+  sh.s = {static_cast<float>(s.a * scale), static_cast<float>(s.b * scale), static_cast<float>(s.at * scale)};
+  for (std::size_t k = 0; k < n_attr; ++k) {
+    sh.n[k] = {static_cast<float>(num[k].a * scale), static_cast<float>(num[k].b * scale), static_cast<float>(num[k].at * scale)};
+  }
+  if (sh.kind == Kind::kTextured) {
+    if (texel_rate == 0.0) {
+      sh.kx = sh.ky = aa;
+    } else {
+      // The texels a pixel spans along x and y at the centre (the denominator is 1 there).
+      const double U = num[0].at * scale, V = num[1].at * scale;
+      const double sa = s.a * scale, sb = s.b * scale;
+      const double du_dx = num[0].a * scale - U * sa, dv_dx = num[1].a * scale - V * sa;
+      const double du_dy = num[0].b * scale - U * sb, dv_dy = num[1].b * scale - V * sb;
+      sh.kx = pow2_at_least(texel_rate * std::hypot(du_dx, dv_dx), aa);
+      sh.ky = pow2_at_least(texel_rate * std::hypot(du_dy, dv_dy), aa);
+    }
+  }
+  return sh;
+}
+
+}  // namespace
+
+Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp::Camera& camera, double far_plane,
+                       std::span<const std::uint32_t> indices) {
+  const auto t_start = Clock::now();
+  const Settings& s = settings_;
+  const int W = s.width, H = s.height, aa = s.aa;
+  if (camera.width != W || camera.height != H) {
+    throw std::invalid_argument("tiler::Renderer::render: camera of " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + " for a " + std::to_string(W) + "x" + std::to_string(H) +
+                                " renderer");
+  }
+  if (!(camera.near_plane > 0.0) || !(far_plane > camera.near_plane) || !std::isfinite(far_plane)) {
+    throw std::invalid_argument("tiler::Renderer::render: near and far planes must satisfy 0 < near < far");
+  }
+  const std::size_t side = static_cast<std::size_t>(std::max(colors.lattice_side, 0));
+  const std::size_t lattice = side * side;
+  if (colors.texture.size() != 4 * lattice || colors.merged_base < lattice || colors.merged_base > colors.positions.size() ||
+      colors.merged_colors.size() != colors.positions.size() - colors.merged_base) {
+    throw std::invalid_argument("tiler::Renderer::render: vertex layout does not match (" + std::to_string(colors.positions.size()) +
+                                " positions, " + std::to_string(lattice) + " lattice samples, texture " +
+                                std::to_string(colors.texture.size()) + " bytes, merged base " + std::to_string(colors.merged_base) +
+                                ", " + std::to_string(colors.merged_colors.size()) + " merged colours)");
+  }
+  if (indices.size() % 3 != 0) throw std::invalid_argument("tiler::Renderer::render: index count not a multiple of 3");
+  const std::size_t n_vertices = colors.positions.size();
+  if (std::any_of(indices.begin(), indices.end(), [&](std::uint32_t i) { return i >= n_vertices; })) {
+    throw std::invalid_argument("tiler::Renderer::render: an index is beyond the " + std::to_string(n_vertices) + " positions");
+  }
+
+  View view;
+  view.eye = camera.eye;
+  view.f = glm::normalize(camera.forward);
+  view.r = glm::normalize(glm::cross(view.f, camera.up));
+  view.u = glm::cross(view.r, view.f);
+  view.focal = H * 0.5 / std::tan(camera.fov_y_deg * 0.5 * 3.14159265358979323846 / 180.0);
+  view.hw = 0.5 * W;
+  view.hh = 0.5 * H;
+  view.near = camera.near_plane;
+  view.far = far_plane;
+
+  Impl& m = *impl_;
+  const std::size_t n_tri = indices.size() / 3;
+  const int R = std::min(s.band_rows, H);
+  const int bands = (H + R - 1) / R;
+  m.band_first.resize(n_tri);
+  m.band_last.resize(n_tri);
+  for (auto& st : m.states) st.stats = Stats{};
+
+  std::unique_ptr<tbb::task_arena> arena;
+  if (s.threads > 0) arena = std::make_unique<tbb::task_arena>(s.threads);
+  const auto run = [&](const auto& f) {
+    if (arena) {
+      arena->execute(f);
+    } else {
+      f();
+    }
+  };
+
+  // Setup: the bands each triangle reaches, then the triangles of each band in order.
+  run([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_tri, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+      std::array<glm::dvec2, kMaxClipped> poly;
+      for (std::size_t t = range.begin(); t != range.end(); ++t) {
+        bool clipped = false;
+        const int n = window_polygon(view, eye_triangle(view, colors.positions, &indices[3 * t]), poly, clipped);
+        double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+        for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+          x0 = std::min(x0, poly[i].x);
+          x1 = std::max(x1, poly[i].x);
+          y0 = std::min(y0, poly[i].y);
+          y1 = std::max(y1, poly[i].y);
+        }
+        if (n == 0 || x1 < 0 || x0 > W || y1 < 0 || y0 > H || !(x0 <= x1) || !(y0 <= y1)) {
+          m.band_first[t] = 1;
+          m.band_last[t] = 0;
+          continue;
+        }
+        m.band_first[t] = std::clamp(static_cast<int>(std::floor(y0)) / R, 0, bands - 1);
+        m.band_last[t] = std::clamp(static_cast<int>(std::floor(y1)) / R, 0, bands - 1);
+      }
+    });
+  });
+  m.band_start.assign(static_cast<std::size_t>(bands) + 1, 0);
+  for (std::size_t t = 0; t < n_tri; ++t)
+    for (int b = m.band_first[t]; b <= m.band_last[t]; ++b) ++m.band_start[static_cast<std::size_t>(b) + 1];
+  for (std::size_t b = 0; b < static_cast<std::size_t>(bands); ++b) m.band_start[b + 1] += m.band_start[b];
+  m.band_items.resize(m.band_start.back());
+  {
+    std::vector<std::uint32_t> next(m.band_start.begin(), m.band_start.end() - 1);
+    for (std::size_t t = 0; t < n_tri; ++t)
+      for (int b = m.band_first[t]; b <= m.band_last[t]; ++b) m.band_items[next[static_cast<std::size_t>(b)]++] = static_cast<std::uint32_t>(t);
+  }
+  const double setup_ms = ms_since(t_start);
+  const auto t_tile = Clock::now();
+
+  const int N = aa * aa;
+  const std::uint64_t full = rect_mask(0, aa, 0, aa);
+  const int per_tile = 8 / aa;  // pixels per tile side
+  const float inv_aa = 1.0f / static_cast<float>(aa);
+  Shader shader;
+  shader.texture = {colors.texture.data(), static_cast<int>(side)};
+  shader.wall = Color(colors.wall_color.r, colors.wall_color.g, colors.wall_color.b);
+  shader.haze = Color(static_cast<float>(look.haze_color.r), static_cast<float>(look.haze_color.g), static_cast<float>(look.haze_color.b));
+  shader.hazy = look.haze_distance > 0.0;
+
+  // One band: its triangles tiled into its own pyramid, front to back, then the sky.
+  const auto draw_band = [&](int band) {
+    Impl::BandState& st = m.states.local();
+    const double cpu0 = thread_cpu_ms();
+    const int row0 = band * R, rows = std::min(R, H - row0);
+    coverage::Pyramid& pyramid = st.pyramid(W * aa, rows * aa);
+    st.classes.clear();
+    const std::size_t count = static_cast<std::size_t>(rows) * static_cast<std::size_t>(W);
+    st.pixels.assign(count, Pixel());
+    // Pixel p of the band: (x, y) with y counted from the band's first row.
+    Accumulator out{st.pixels.data(),
+                    st.classes, st.stats, full};
+
+    std::array<glm::dvec2, kMaxClipped> poly;
+    for (std::size_t item = m.band_start[static_cast<std::size_t>(band)]; item < m.band_start[static_cast<std::size_t>(band) + 1]; ++item) {
+      const std::uint32_t t = m.band_items[item];
+      const std::uint32_t* idx = &indices[3 * static_cast<std::size_t>(t)];
+      const std::array<Eye, 3> tri = eye_triangle(view, colors.positions, idx);
+      bool clipped = false;
+      const int n = window_polygon(view, tri, poly, clipped);
+      if (n == 0) continue;
+      const bool first_band = band == m.band_first[t];
+      st.stats.clipped += clipped && first_band ? 1 : 0;
+      const Shade sh = setup_shade(view, colors, look, s.texel_rate, aa, idx, tri, poly, n);
+      st.stats.translucent += sh.translucent && first_band ? 1 : 0;
+
+      // Tiling: the band's pyramid is in samples, its row 0 the band's first.
+      st.poly.resize(static_cast<std::size_t>(n));
+      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) st.poly[i] = {poly[i].x * aa, (poly[i].y - row0) * aa};
+      st.records.clear();
+      if (sh.translucent) {
+        pyramid.vacant(st.poly, 0.0, st.records);
+      } else {
+        pyramid.cover(st.poly, 0.0, st.records);
+      }
+      ++st.stats.tiled;
+
+      // The fragments: per pixel of each reported tile, its newly covered (or shown) samples.
+      const bool blocks = sh.kx > 1 || sh.ky > 1;
+      const float y_base = static_cast<float>(row0);
+      // Pixel (px, py) of the band, its samples sub (count c, centroid q in samples), the pixel's
+      // covered samples (translucent triangles only).
+      const auto fragment = [&](int px, int py, std::uint64_t sub, int c, glm::vec2 q, std::uint64_t covered) {
+        const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
+        ++st.stats.fragments;
+        const float x = static_cast<float>(px) + q.x * inv_aa, y = y_base + static_cast<float>(py) + q.y * inv_aa;
+        float alpha = 1.0f;
+        if (sh.translucent) {
+          ++st.stats.shading_points;
+          const Color col = shader(sh, x, y, alpha);
+          out.translucent(p, sub, c, covered, col, alpha);
+        } else if (!blocks) {
+          ++st.stats.shading_points;
+          out.opaque(p, sub, c, shader(sh, x, y, alpha));
+        } else {
+          // Block by block: each block's samples shaded at their centroid.
+          out.px[p].count += static_cast<std::uint32_t>(c);
+          st.stats.samples_covered += static_cast<std::uint64_t>(c);
+          const int bw = aa / sh.kx, bh = aa / sh.ky;
+          for (int by = 0; by < sh.ky; ++by) {
+            for (int bx = 0; bx < sh.kx; ++bx) {
+              const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
+              if (!part) continue;
+              const int pc = popcount(part);
+              const glm::vec2 pq = centroid(part, pc);
+              ++st.stats.shading_points;
+              out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
+            }
+          }
+        }
+      };
+      const glm::vec2 centre(0.5f * static_cast<float>(aa));
+      for (const coverage::TileMask& rec : st.records) {
+        if (rec.run > 1) {
+          // Whole tiles (a cell the triangle covers): every sample of every pixel, vacant before.
+          for (int j = 0; j < per_tile; ++j) {
+            const int py = rec.ty * per_tile + j;
+            for (int px = rec.tx * per_tile; px < (rec.tx + rec.run) * per_tile; ++px) fragment(px, py, full, N, centre, 0);
+          }
+          continue;
+        }
+        for (int j = 0; j < per_tile; ++j) {
+          for (int i = 0; i < per_tile; ++i) {
+            const int shift = 8 * j * aa + i * aa;
+            const std::uint64_t sub = (rec.mask >> shift) & full;
+            if (!sub) continue;
+            const bool whole = sub == full;
+            const int c = whole ? N : popcount(sub);
+            const std::uint64_t covered = sh.translucent ? (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full : 0;
+            fragment(rec.tx * per_tile + i, rec.ty * per_tile + j, sub, c, whole ? centre : centroid(sub, c), covered);
+          }
+        }
+      }
+    }
+
+    // The sky over every sample still vacant (section 4.5: "composite a screen-sized polygon of
+    // the desired background color"), then the band's pixels.
+    const int tiles_x = pyramid.grid_width(0), tiles_y = pyramid.grid_height(0);
+    const Color bottom(static_cast<float>(look.sky_bottom.r), static_cast<float>(look.sky_bottom.g), static_cast<float>(look.sky_bottom.b));
+    const Color top(static_cast<float>(look.sky_top.r), static_cast<float>(look.sky_top.g), static_cast<float>(look.sky_top.b));
+    const float inv_h = 1.0f / static_cast<float>(H);
+    for (int ty = 0; ty < tiles_y; ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const std::uint64_t open = ~pyramid.tile_bits(tx, ty);
+        if (!open) continue;
+        for (int j = 0; j < per_tile; ++j) {
+          for (int i = 0; i < per_tile; ++i) {
+            const std::uint64_t sub = (open >> (8 * j * aa + i * aa)) & full;
+            if (!sub) continue;
+            const int px = tx * per_tile + i, py = ty * per_tile + j;
+            const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
+            const int c = sub == full ? N : popcount(sub);
+            const float qy = sub == full ? 0.5f * aa : centroid(sub, c).y;
+            const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;
+            out.add(p, sub, c, bottom + (top - bottom) * f, 1.0f);
+            out.px[p].count += static_cast<std::uint32_t>(c);
+            st.stats.samples_background += static_cast<std::uint64_t>(c);
+          }
+        }
+      }
+    }
+    const float scale = 1.0f / static_cast<float>(N);
+    for (int y = 0; y < rows; ++y) {
+      const std::size_t src = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
+      const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
+      for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
+        const std::array<float, 4> v = (out.px[src + x].acc * scale).lanes();
+        for (std::size_t k = 0; k < 3; ++k) rgb_[3 * (dst + x) + k] = static_cast<std::uint8_t>(std::clamp(v[k] + 0.5f, 0.0f, 255.0f));
+        counts_[dst + x] = static_cast<std::uint8_t>(std::min<std::uint32_t>(out.px[src + x].count, 255));
+      }
+    }
+    st.stats.cells_visited += pyramid.stats().cells_visited;
+    st.stats.tile_cpu_ms += thread_cpu_ms() - cpu0;
+  };
+
+  run([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& r) {
+      for (int b = r.begin(); b != r.end(); ++b) draw_band(b);
+    });
+  });
+
+  Stats total;
+  total.triangles = n_tri;
+  for (const Impl::BandState& st : m.states) {
+    total.translucent += st.stats.translucent;
+    total.clipped += st.stats.clipped;
+    total.tiled += st.stats.tiled;
+    total.fragments += st.stats.fragments;
+    total.shading_points += st.stats.shading_points;
+    total.samples_covered += st.stats.samples_covered;
+    total.samples_background += st.stats.samples_background;
+    total.cells_visited += st.stats.cells_visited;
+    total.class_splits += st.stats.class_splits;
+    total.tile_cpu_ms += st.stats.tile_cpu_ms;
+  }
+  total.setup_ms = setup_ms;
+  total.tile_ms = ms_since(t_tile);
+  total.total_ms = ms_since(t_start);
+  return total;
+}
+
+}  // namespace terravol::tiler
