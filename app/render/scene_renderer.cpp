@@ -13,6 +13,9 @@
 #include <malloc.h>
 #endif
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
 #include "app/scene/ground_grid.h"
 #include "app/scene/mosaic_lattice.h"
 #include "app/scene/profile_path.h"
@@ -322,6 +325,17 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   } else {
     boxes_.clear();
     volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+    if (!boxes_.empty()) {
+      // The far plane holds the density's cells too (they may lie beyond the window).
+      const double window_far = scene_->far_plane(camera_.eye);
+      double far = 0.0;
+      for (const mrbsp::ColorBox& b : boxes_) {
+        const glm::dvec3 d = glm::max(glm::abs(glm::dvec3(b.lo) - camera_.eye), glm::abs(glm::dvec3(b.hi) - camera_.eye));
+        far = std::max(far, glm::dot(d, d));
+      }
+      far = std::sqrt(far) * 1.05 + 100.0;
+      if (far > window_far) renderer_->set_camera(camera_, far);
+    }
     stats.density_ms = ms_since(t0);
     t0 = Clock::now();
     scene_->tree().traverse(camera_, traversal, frame_, boxes_);
