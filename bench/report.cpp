@@ -336,7 +336,7 @@ void density_section(std::ostringstream& md, const json& results) {
   }
   md << "\nThe default RF volume (scripts/setup-and-run.sh) from the default scene's camera:\n\n"
      << "| scene | frame ms | transfer change to frame ms | cells | faces | refine / order / draw ms | "
-        "against the ray marcher (mean, 99th pct) | bsp vs exact peel within 3/255 |\n|---|---|---|---|---|---|---|---|\n";
+        "against the ray marcher (mean, 99th pct) | bsp vs exact peel within 3/255 (cubes up to 64 px) |\n|---|---|---|---|---|---|---|---|\n";
   for (const json& v : d["default_volume"]) {
     md << "| " << (v["surfaces"].get<bool>() ? "with isosurfaces and slice" : "density alone") << " | "
        << spread(v["frame_ms"]) << " | " << spread(v["transfer_change_to_frame_ms"]) << " | "

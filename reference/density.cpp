@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -144,6 +145,29 @@ std::vector<unsigned char> composite_over(const MarchedImage& m, const std::vect
     }
   }
   return out;
+}
+
+FootprintError footprint_error(const MarchedImage& m, const std::function<double(std::size_t p)>& worst) {
+  std::vector<double> e;
+  for (std::size_t p = 0; p < m.inside.size(); ++p)
+    if (m.inside[p]) e.push_back(worst(p));
+  FootprintError out;
+  out.pixels = e.size();
+  if (e.empty()) return out;
+  for (const double v : e) out.mean += v;
+  out.mean /= static_cast<double>(e.size());
+  std::sort(e.begin(), e.end());
+  out.p99 = e[static_cast<std::size_t>(0.99 * static_cast<double>(e.size() - 1))];
+  return out;
+}
+
+FootprintError footprint_error(const MarchedImage& m, const std::vector<unsigned char>& ours,
+                               const std::vector<unsigned char>& expected) {
+  return footprint_error(m, [&](std::size_t p) {
+    int worst = 0;
+    for (std::size_t k = 0; k < 3; ++k) worst = std::max(worst, std::abs(int(ours[3 * p + k]) - int(expected[3 * p + k])));
+    return static_cast<double>(worst);
+  });
 }
 
 }  // namespace terravol::reference

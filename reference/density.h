@@ -77,4 +77,17 @@ MarchedImage march_density(const DensityField& field, const DensityTransfer& tra
 // rgb + (1 - a) background, rounded.
 std::vector<unsigned char> composite_over(const MarchedImage& marched, const std::vector<unsigned char>& background);
 
+// How far an image lies from the marcher's inside its footprint (pixels with `inside`): per
+// pixel the largest channel difference in 1/255, their mean and 99th percentile (the issue's
+// figures; the nearest rank below). All zero when no pixel is inside.
+struct FootprintError {
+  double mean = 0.0, p99 = 0.0;
+  std::size_t pixels = 0;
+};
+// `worst(p)`: pixel p's largest channel difference, in 1/255.
+FootprintError footprint_error(const MarchedImage& marched, const std::function<double(std::size_t p)>& worst);
+// `ours` against `expected`, both RGB bytes (3 a pixel, row 0 at the top).
+FootprintError footprint_error(const MarchedImage& marched, const std::vector<unsigned char>& ours,
+                               const std::vector<unsigned char>& expected);
+
 }  // namespace terravol::reference

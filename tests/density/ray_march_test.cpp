@@ -20,27 +20,12 @@
 namespace terravol::density {
 namespace {
 
-struct Errors {
-  double mean = 0.0, p99 = 0.0;  // of the largest channel difference, in 1/255
-  std::size_t pixels = 0;        // inside the volume's box
-};
-
-Errors compare(const std::vector<glm::vec4>& ours, const reference::MarchedImage& marched) {
-  std::vector<double> e;
-  for (std::size_t p = 0; p < ours.size(); ++p) {
-    if (!marched.inside[p]) continue;
+reference::FootprintError compare(const std::vector<glm::vec4>& ours, const reference::MarchedImage& marched) {
+  return reference::footprint_error(marched, [&](std::size_t p) {
     double worst = 0.0;
     for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(static_cast<double>(ours[p][c]) - marched.rgba[p][c]) * 255.0);
-    e.push_back(worst);
-  }
-  Errors out;
-  out.pixels = e.size();
-  if (e.empty()) return out;
-  for (double v : e) out.mean += v;
-  out.mean /= static_cast<double>(e.size());
-  std::sort(e.begin(), e.end());
-  out.p99 = e[static_cast<std::size_t>(0.99 * static_cast<double>(e.size() - 1))];
-  return out;
+    return worst;
+  });
 }
 
 TEST(DensityReference, ColourCubesAgreeWithTheRayMarcherFromNearAndFar) {
@@ -69,7 +54,7 @@ TEST(DensityReference, ColourCubesAgreeWithTheRayMarcherFromNearAndFar) {
     const reference::MarchedImage marched = reference::march_density(field, transfer, mc, 20.0, [](double, double) {
       return -std::numeric_limits<double>::infinity();
     });
-    Errors e[2];
+    reference::FootprintError e[2];
     for (int variant = 0; variant < 2; ++variant) {
       std::vector<mrbsp::ColorBox> boxes;
       RefineStats stats;
