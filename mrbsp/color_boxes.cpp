@@ -7,8 +7,9 @@
 // traversal sends them through the tree as it decided it for this frame, without changing it,
 // and keeps each piece in a bucket at the place of the tree's order where it belongs:
 //   - the window's boundary planes first, in the walk's chain (west, east, south, north: a box
-//     beyond two belongs to the first): what lies beyond goes to that side's outside slot, or
-//     to a bucket drawn where that slot would be;
+//     beyond two belongs to the first): what lies beyond is cut into that side's bands (and,
+//     south and north, level-0 columns) as the merge cuts pieces (merge.cpp, to_bands), each
+//     part into its place's outside slot, or a bucket drawn where that slot would be;
 //   - at every cell the walk enters, the plane z = h of its separation height (an LOD cell's
 //     terrain zmax; a top cell's zmax or the top of its subtree's merged content, whichever is
 //     higher): everything the cell's subtree draws lies below it, so what lies above is drawn
