@@ -63,6 +63,34 @@ glm::vec4 cover(const glm::vec4& front, const glm::vec4& back) {
   return glm::vec4(glm::vec3(front) + share * glm::vec3(back), a);
 }
 
+// A cell's six faces from its eight children's (child c at offset (c & 1, c >> 1 & 1, c >> 2);
+// children beyond the level below, `dc` cells per axis, are clear), 1996 section 4: per axis a,
+// each column of two children composited front over back along a (low face: the low child in
+// front; high face: the high one), and the columns that lie inside the level below averaged.
+Faces compose(const Faces (&child)[8], const std::array<int, 3>& dc, int i, int j, int k, Compositing compositing) {
+  const auto composite = compositing == Compositing::kOver ? over : cover;
+  const int idx[3] = {i, j, k};
+  Faces f{};
+  for (int a = 0; a < 3; ++a) {
+    const int bit = 1 << a, u = (a + 1) % 3, v = (a + 2) % 3;
+    glm::vec4 low_first(0.0f), high_first(0.0f);
+    int columns = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (c & bit) continue;
+      const int cu = 2 * idx[u] + ((c >> u) & 1), cv = 2 * idx[v] + ((c >> v) & 1);
+      if (cu >= dc[static_cast<std::size_t>(u)] || cv >= dc[static_cast<std::size_t>(v)]) continue;
+      ++columns;
+      const std::size_t lo = static_cast<std::size_t>(c), hi = static_cast<std::size_t>(c | bit);
+      low_first += composite(child[lo][static_cast<std::size_t>(2 * a)], child[hi][static_cast<std::size_t>(2 * a)]);
+      high_first += composite(child[hi][static_cast<std::size_t>(2 * a + 1)], child[lo][static_cast<std::size_t>(2 * a + 1)]);
+    }
+    const float w = columns > 0 ? 1.0f / static_cast<float>(columns) : 0.0f;
+    f[static_cast<std::size_t>(2 * a)] = w * low_first;
+    f[static_cast<std::size_t>(2 * a + 1)] = w * high_first;
+  }
+  return f;
+}
+
 Packed pack(const Faces& f) {
   Packed p{};
   for (std::size_t k = 0; k < 6; ++k) {
@@ -303,33 +331,11 @@ Faces ColorCubeOctree::build_cell(int level, int i, int j, int k) {
   if (level == 0) return leaf_faces(i, j, k);
   const auto& dc = dims_[static_cast<std::size_t>(level - 1)];
   Faces child[8];
-  bool exists[8];
   for (int c = 0; c < 8; ++c) {
     const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
-    exists[c] = ci < dc[0] && cj < dc[1] && ck < dc[2];
-    child[c] = exists[c] ? build_cell(level - 1, ci, cj, ck) : Faces{};
+    child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? build_cell(level - 1, ci, cj, ck) : Faces{};
   }
-  Faces f{};
-  const auto composite = options_.compositing == Compositing::kOver ? over : cover;
-  const int idx[3] = {i, j, k};
-  for (int a = 0; a < 3; ++a) {
-    const int bit = 1 << a, u = (a + 1) % 3, v = (a + 2) % 3;
-    glm::vec4 low_first(0.0f), high_first(0.0f);
-    int columns = 0;
-    for (int c = 0; c < 8; ++c) {
-      if (c & bit) continue;
-      // The pair (c, c | bit) exists when its column lies inside the level below.
-      const int cu = 2 * idx[u] + ((c >> u) & 1), cv = 2 * idx[v] + ((c >> v) & 1);
-      if (cu >= dc[static_cast<std::size_t>(u)] || cv >= dc[static_cast<std::size_t>(v)]) continue;
-      ++columns;
-      const std::size_t lo = static_cast<std::size_t>(c), hi = static_cast<std::size_t>(c | bit);
-      low_first += composite(child[lo][static_cast<std::size_t>(2 * a)], child[hi][static_cast<std::size_t>(2 * a)]);
-      high_first += composite(child[hi][static_cast<std::size_t>(2 * a + 1)], child[lo][static_cast<std::size_t>(2 * a + 1)]);
-    }
-    const float w = columns > 0 ? 1.0f / static_cast<float>(columns) : 0.0f;
-    f[static_cast<std::size_t>(2 * a)] = w * low_first;
-    f[static_cast<std::size_t>(2 * a + 1)] = w * high_first;
-  }
+  const Faces f = compose(child, dc, i, j, k, options_.compositing);
   packed_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)] = pack(f);
   return f;
 }
@@ -381,34 +387,16 @@ void ColorCubeOctree::build_all() {
     const auto& dc = dims_[static_cast<std::size_t>(lv - 1)];
     auto& out = above[static_cast<std::size_t>(lv)];
     out.assign(static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]), Faces{});
-    const auto composite = options_.compositing == Compositing::kOver ? over : cover;
     for (int k = 0; k < d[2]; ++k)
       for (int j = 0; j < d[1]; ++j)
         for (int i = 0; i < d[0]; ++i) {
-          const int idx[3] = {i, j, k};
-          Faces f{};
-          for (int a = 0; a < 3; ++a) {
-            const int bit = 1 << a, u = (a + 1) % 3, v = (a + 2) % 3;
-            glm::vec4 low_first(0.0f), high_first(0.0f);
-            int columns = 0;
-            for (int c = 0; c < 8; ++c) {
-              if (c & bit) continue;
-              const int cu = 2 * idx[u] + ((c >> u) & 1), cv = 2 * idx[v] + ((c >> v) & 1);
-              if (cu >= dc[static_cast<std::size_t>(u)] || cv >= dc[static_cast<std::size_t>(v)]) continue;
-              ++columns;
-              const auto child = [&](int cc) -> const Faces& {
-                static const Faces none{};
-                const int ci = 2 * i + (cc & 1), cj = 2 * j + ((cc >> 1) & 1), ck = 2 * k + (cc >> 2);
-                if (ci >= dc[0] || cj >= dc[1] || ck >= dc[2]) return none;
-                return above[static_cast<std::size_t>(lv - 1)][cell_index(lv - 1, ci, cj, ck)];
-              };
-              low_first += composite(child(c)[static_cast<std::size_t>(2 * a)], child(c | bit)[static_cast<std::size_t>(2 * a)]);
-              high_first += composite(child(c | bit)[static_cast<std::size_t>(2 * a + 1)], child(c)[static_cast<std::size_t>(2 * a + 1)]);
-            }
-            const float w = columns > 0 ? 1.0f / static_cast<float>(columns) : 0.0f;
-            f[static_cast<std::size_t>(2 * a)] = w * low_first;
-            f[static_cast<std::size_t>(2 * a + 1)] = w * high_first;
+          Faces child[8];
+          for (int c = 0; c < 8; ++c) {
+            const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
+            child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? above[static_cast<std::size_t>(lv - 1)][cell_index(lv - 1, ci, cj, ck)]
+                                                              : Faces{};
           }
+          const Faces f = compose(child, dc, i, j, k, options_.compositing);
           out[cell_index(lv, i, j, k)] = f;
           packed_[static_cast<std::size_t>(lv)][cell_index(lv, i, j, k)] = pack(f);
         }
