@@ -319,16 +319,17 @@ void density_section(std::ostringstream& md, const json& results) {
      << "A 6 km path-loss volume over the bundled DEM (N45E006; 6 arc seconds, 0-2000 m every 100 m) and the same "
         "lattice refined 2x and 4x per axis, drawn as a density (" << d["transfer"].get<std::string>() << ") in the "
         "tree's order: the colour-cube octree at epsilon 1 px against every voxel cell (the same path, every leaf in "
-        "the frustum; left out above 3 million cells), from 1.75 to 14 volume radii. Frame: the octree's refinement, "
+        "the frustum; either left out above 3 million cells), from 1.75 to 14 volume radii. Frame: the octree's refinement, "
         "the traversal that orders its cells with the terrain, upload and draw.\n\n"
      << "| lattice | radii | octree ms | cells (per level from the leaves) | every cell ms | every cell / octree | "
         "every-cell cells |\n|---|---|---|---|---|---|---|\n";
   for (const json& s : d["series"]) {
     for (const json& v : s["views"]) {
       std::string levels;
-      for (const json& n : v["octree_cells_per_level"]) levels += (levels.empty() ? "" : " ") + std::to_string(n.get<std::size_t>());
+      if (v.contains("octree_cells_per_level"))
+        for (const json& n : v["octree_cells_per_level"]) levels += (levels.empty() ? "" : " ") + std::to_string(n.get<std::size_t>());
       md << "| " << s["factor"].get<int>() << "x | " << num(v["radii"].get<double>()) << " | "
-         << num(v["octree_ms"].get<double>(), "%.1f") << " | " << v["octree_cells"].get<std::size_t>() << " (" << levels << ") | "
+         << (v.contains("octree_ms") ? num(v["octree_ms"].get<double>(), "%.1f") : std::string("not drawn")) << " | " << v["octree_cells"].get<std::size_t>() << " (" << levels << ") | "
          << (v.contains("every_ms") ? num(v["every_ms"].get<double>(), "%.1f") : std::string("not drawn")) << " | "
          << (v.contains("every_over_octree") ? num(v["every_over_octree"].get<double>(), "%.2f") + "x" : std::string("-"))
          << " | " << v["every_cells"].get<std::size_t>() << " |\n";
