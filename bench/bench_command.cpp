@@ -33,7 +33,7 @@ struct BenchOptions {
   std::vector<std::filesystem::path> dems;
   std::filesystem::path under_test;
   std::string exactness_views;
-  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects,lowalt,aa";
+  std::string suites = "terrain,translucency,scaling,build,exactness,rf,objects,lowalt,aa,density";
   int views = 0, repeats = 0, frames = 0;
 };
 
@@ -85,13 +85,13 @@ std::string today() {
 }
 
 std::set<std::string> parse_suites(const std::string& list) {
-  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects", "lowalt", "aa"};
+  static const std::set<std::string> known{"terrain", "translucency", "scaling", "build", "exactness", "rf", "objects", "lowalt", "aa", "density"};
   std::set<std::string> out;
   std::stringstream in(list);
   for (std::string s; std::getline(in, s, ',');) {
     if (!known.count(s)) {
       throw std::runtime_error("--suites " + list + ": unknown suite '" + s +
-                               "' (terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa)");
+                               "' (terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa, density)");
     }
     out.insert(s);
   }
@@ -206,6 +206,15 @@ void run_bench(const BenchOptions& o, const std::string& command) {
       results["objects"] = object_suite(c, real.front(), truck, wuson);
     }
   }
+  if (suites.count("density")) {
+    // The bundled DEM, as the project's scripts make it (scripts/setup-and-run.sh).
+    const std::filesystem::path bundled = "data/dem/N45E006.hgt";
+    if (!std::filesystem::exists(bundled)) {
+      c.log(bundled.string() + " not found (run from the project root; terravol sample-dem -o data/dem makes it): the density suite is skipped");
+    } else {
+      results["density"] = density_suite(c, Terrain{"n45e006", {bundled}, 1});
+    }
+  }
   if (suites.count("scaling")) {
     // One tile, the six Utah tiles when there, and 16 tiles of the project's own generator.
     const auto tiles = c.cache / "tiles";
@@ -251,7 +260,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("-o,--output-dir", o->out, "Folder for results.json, report.md and the plots (and cache/)")->capture_default_str();
   cmd->add_option("--data", o->data, "The shared data folder (with dem/); default $TERRAVOL_SHARED_DATA or ../shared/data");
   cmd->add_option("--dem", o->dems, "Benchmark these DEM files as one terrain instead of the shared ones");
-  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa")->capture_default_str();
+  cmd->add_option("--suites", o->suites, "Comma-separated: terrain, translucency, scaling, build, exactness, rf, objects, lowalt, aa, density")->capture_default_str();
   cmd->add_option("--under-test", o->under_test,
                   "The terravol executable whose render the exactness suite measures (default: this one)")
       ->check(CLI::ExistingFile);

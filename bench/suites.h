@@ -142,4 +142,19 @@ nlohmann::json lowalt_suite(const BenchConfig& config, const Terrain& terrain);
 // first view's images go to out/aa/. Throws what SceneRenderer throws.
 nlohmann::json aa_suite(const BenchConfig& config, const Terrain& terrain, const std::vector<volume::Transmitter>& transmitters);
 
+// 12. Densities (issue 15; bench/density_suite.cpp), over the bundled DEM (N45E006, made by
+// `terravol sample-dem`; its default transmitter at 45.5 N, 6.5 E, 30 m): a 6 km path-loss
+// volume (6", 0-2000 m every 100 m) and the same refined 2x and 4x per axis, each seen from
+// 1.75, 3.5, 7 and 14 volume radii (from the south-west, 30 degrees up): per view, side by side,
+// the colour-cube octree at epsilon 1 px and every voxel cell (left out above 3 million
+// cells), frame times (the refinement, the traversal that orders the cells, upload and draw),
+// cells and faces. Then the default RF volume of scripts/setup-and-run.sh (20 km, 0-2000 m
+// every 50 m) from the default scene's camera: the density alone and with the default scene's
+// two isosurfaces and agl slice: frame time, a transfer-function change to the finished frame;
+// the density alone against the independent ray marcher over the terrain-only image (mean and
+// 99th percentile of the largest channel difference inside the volume's box); with the
+// surfaces, bsp against VTK's exact depth peeling of the same polygons. Transfer function:
+// range 80:150 dB, viridis, 0.5 per km, ramp down. Throws what SceneRenderer throws.
+nlohmann::json density_suite(const BenchConfig& config, const Terrain& terrain);
+
 }  // namespace terravol::bench

@@ -10,7 +10,7 @@
 # third-party includes the target may not use (e.g. "^vtk" for no VTK, "^CLI/" for no CLI11).
 # SOURCES_ONLY: the target's sources alone, not the folder's headers (an executable beside the
 # folder's library). The check runs again whenever one of those files changes.
-set(TERRAVOL_PROJECT_FOLDERS app bench coverage fuzz io mrbsp objects reference tests tiler volume)
+set(TERRAVOL_PROJECT_FOLDERS app bench coverage density fuzz io mrbsp objects reference tests tiler volume)
 
 function(terravol_check_includes target)
   cmake_parse_arguments(PARSE_ARGV 1 arg "SOURCES_ONLY" "" "ALLOW;FORBID")

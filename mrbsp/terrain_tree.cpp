@@ -37,6 +37,7 @@
 #include "mrbsp/tree_impl.h"
 
 #include "coverage/pyramid.h"
+#include "mrbsp/box_order.h"
 
 #include <algorithm>
 #include <array>
@@ -423,12 +424,14 @@ double box_area_px(const Camera& c, const glm::dvec3& f, const glm::dvec3& r, co
 
 // Traversal stack items: an implicit node name or a slot to emit, packed into 64 bits.
 // Bits 0-2 kind, 3-8 level + top, 9-29 ci, 30-50 cj, 51 half (which x half); slots: bits 3+.
-enum : std::uint64_t { kSquare = 0, kHalf = 1, kEmitSlot = 2, kLeaf = 3 };
+enum : std::uint64_t { kSquare = 0, kHalf = 1, kEmitSlot = 2, kLeaf = 3, kEmitBoxes = 4 };
 constexpr std::uint64_t pack(std::uint64_t kind, int level_index, int ci, int cj, int half = 0) {
   return kind | (static_cast<std::uint64_t>(level_index) << 3) | (static_cast<std::uint64_t>(ci) << 9) |
          (static_cast<std::uint64_t>(cj) << 30) | (static_cast<std::uint64_t>(half) << 51);
 }
 constexpr std::uint64_t pack_slot(std::int32_t slot) { return kEmitSlot | (static_cast<std::uint64_t>(slot) << 3); }
+// A bucket of colour boxes (mrbsp/box_order.h), emitted like a slot.
+constexpr std::uint64_t pack_boxes(std::int32_t bucket) { return kEmitBoxes | (static_cast<std::uint64_t>(bucket) << 3); }
 constexpr std::uint64_t kind_of(std::uint64_t item) { return item & 7u; }
 constexpr int level_index_of(std::uint64_t item) { return static_cast<int>((item >> 3) & 63u); }
 constexpr int ci_of(std::uint64_t item) { return static_cast<int>((item >> 9) & 0x1FFFFFu); }
@@ -438,11 +441,19 @@ constexpr std::int32_t slot_of(std::uint64_t item) { return static_cast<std::int
 
 }  // namespace
 
-void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const {
+void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options, Frame& frame,
+                           std::span<const ColorBox> boxes) const {
   Impl& lazy = *impl_;  // builds the low alternatives it draws for the first time
   const Impl& m = lazy;
   frame.indices.clear();
   frame.level.clear();
+  frame.transient_positions.clear();
+  frame.transient_colors.clear();
+  frame.boxes = {};
+  if (frame.box_scratch_) frame.box_scratch_->active = false;
+  // Set once the boxes are distributed (after the occlusion pass): the walk of pass 4 then
+  // puts their buckets in its order.
+  BoxScratch* box_order = nullptr;
   frame.nodes_visited = 0;
   frame.leaves = 0;
   frame.crack_triangles = 0;
@@ -616,30 +627,38 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     auto& places = frame.outside_places_;
     for (int side = 3; side >= 0; --side) {
       const std::vector<std::int32_t>& slots = m.outside[static_cast<std::size_t>(side)];
-      if (slots.empty()) continue;
+      // Colour boxes beyond the side in places without a slot (BoxScratch::outside_places).
+      const std::vector<BoxScratch::OutsideBoxes>* boxed = box_order ? &box_order->outside_places(side) : nullptr;
+      if (slots.empty() && (boxed == nullptr || boxed->empty())) continue;
       // Each place is a box: its band's slab across the side's axis, its column's along the
       // other (south and north); sorted by the band's distance from the eye, then the column's.
       const double eye_at = side < 2 ? e.x : e.y;
       places.clear();
-      for (const std::int32_t slot : slots) {
-        const OutsidePlace p = outside_place(m.slots[static_cast<std::size_t>(slot)].key);
-        const double a = m.band_plane(side, p.band);
-        const double b = p.band + 1 < kBands ? m.band_plane(side, p.band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
+      const auto place = [&](int band, int column, std::uint64_t item) {
+        const double a = m.band_plane(side, band);
+        const double b = band + 1 < kBands ? m.band_plane(side, band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
         double column_distance = 0.0;
         if (side >= 2) {
           const int s0 = m.cell_size(0);
-          const double x0 = m.xs[static_cast<std::size_t>(p.column * s0)], x1 = m.xs[static_cast<std::size_t>((p.column + 1) * s0)];
+          const double x0 = m.xs[static_cast<std::size_t>(column * s0)], x1 = m.xs[static_cast<std::size_t>((column + 1) * s0)];
           column_distance = e.x < x0 ? x0 - e.x : e.x > x1 ? e.x - x1 : 0.0;
         }
         const double lo = std::min(a, b), hi = std::max(a, b);
         const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
-        places.push_back({band_distance, column_distance, slot});
+        places.push_back({band_distance, column_distance, item});
+      };
+      for (const std::int32_t slot : slots) {
+        const OutsidePlace p = outside_place(m.slots[static_cast<std::size_t>(slot)].key);
+        place(p.band, p.column, pack_slot(slot));
+      }
+      if (boxed != nullptr) {
+        for (const BoxScratch::OutsideBoxes& b : *boxed) place(b.band, b.column, pack_boxes(b.bucket));
       }
       std::sort(places.begin(), places.end(), [&](const Frame::OutsideOrder& p, const Frame::OutsideOrder& q) {
         if (p.band_distance != q.band_distance) return b2f ? p.band_distance > q.band_distance : p.band_distance < q.band_distance;
         return b2f ? p.column_distance > q.column_distance : p.column_distance < q.column_distance;
       });
-      for (const Frame::OutsideOrder& p : places) order.push_back(pack_slot(p.slot));
+      for (const Frame::OutsideOrder& p : places) order.push_back(p.item);
       // After everything inside, or before it.
       if (beyond[side] != b2f) std::rotate(order.begin(), order.end() - static_cast<std::ptrdiff_t>(places.size()), order.end());
     }
@@ -648,7 +667,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       const std::uint64_t item = stack.back();
       stack.pop_back();
       const std::uint64_t kind = kind_of(item);
-      if (kind == kEmitSlot || kind == kLeaf) {
+      if (kind == kEmitSlot || kind == kLeaf || kind == kEmitBoxes) {
         out(item);
         continue;
       }
@@ -666,28 +685,48 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       }
       // A square: a top cell (always split, if in view) or an LOD cell as decided.
       bool refine = true;
+      // A cell left out keeps the colour boxes of its whole column, drawn in its place.
+      const auto left_out = [&] {
+        const std::int32_t b = box_order ? box_order->whole(level_index, ci, cj) : -1;
+        if (b >= 0) out(pack_boxes(b));
+      };
       if (level >= 0) {
         const std::uint32_t st = state(m.cell_id(level, ci, cj));
-        if (st == 0 || !enter(level, ci, cj, -1)) continue;  // out of view, or hidden
+        if (st == 0 || !enter(level, ci, cj, -1)) {  // out of view, or hidden
+          left_out();
+          continue;
+        }
         refine = st == kRefined;
       } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
+        left_out();
         continue;
       }
       const CellContent* content = content_of(level, ci, cj);
       // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
       // eye is below the plane z = zmax they are far), the terrain part, the pieces above
-      // (when the eye is above that plane they are near). Pushed in reverse.
-      const bool above_near = content && content->above >= 0 && e.z >= static_cast<double>(m.cell_z(level, ci, cj).zmax);
-      const bool above_first = content && content->above >= 0 && above_near != b2f;
-      const bool above_last = content && content->above >= 0 && !above_first;
-      if (above_last) stack.push_back(pack_slot(content->above));
+      // (when the eye is above that plane they are near). Pushed in reverse. Colour boxes above
+      // the cell go into its above slot when it has one, else they come out in its place, at
+      // their separation height (mrbsp/box_order.h).
+      std::uint64_t above = 0;
+      double above_z = 0.0;
+      if (content && content->above >= 0) {
+        above = pack_slot(content->above);
+        above_z = static_cast<double>(m.cell_z(level, ci, cj).zmax);
+      } else if (const std::int32_t b = box_order ? box_order->above(level_index, ci, cj) : -1; b >= 0) {
+        above = pack_boxes(b);
+        above_z = static_cast<double>(separation_height(m, level, ci, cj));
+      }
+      const bool above_near = above != 0 && e.z >= above_z;
+      const bool above_first = above != 0 && above_near != b2f;
+      const bool above_last = above != 0 && !above_first;
+      if (above_last) stack.push_back(above);
       if (refine) {
         const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
         if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
       } else {
         stack.push_back(pack(kLeaf, level_index, ci, cj));
       }
-      if (above_first) stack.push_back(pack_slot(content->above));
+      if (above_first) stack.push_back(above);
     }
   };
   // A drawn cell's crack fills: where the same-level neighbour is refined, balance put it one
@@ -904,6 +943,30 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     frame.occlusion.pass_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 
+  // The colour boxes, sent through the decided tree (mrbsp/color_boxes.cpp): from here the walk
+  // puts their buckets in its order.
+  if (!boxes.empty()) {
+    if (!frame.box_scratch_) frame.box_scratch_ = std::make_unique<BoxScratch>();
+    Decided decided;
+    decided.marks = &marks;
+    decided.stamp = stamp;
+    if (occlusion) {
+      decided.visibility = &frame.visibility_;
+      decided.hidden = frame.current_stamp_ << 2 | kWasHidden;
+    }
+    decided.top_in_view.resize(static_cast<std::size_t>(m.top));
+    for (int li = 0; li < m.top; ++li) {
+      const int level = li - m.top, cells = m.cells_at(level);
+      auto& flags = decided.top_in_view[static_cast<std::size_t>(li)];
+      flags.resize(static_cast<std::size_t>(cells * cells));
+      for (int cj = 0; cj < cells; ++cj)
+        for (int ci = 0; ci < cells; ++ci)
+          flags[static_cast<std::size_t>(cj * cells + ci)] = in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj))) ? 1 : 0;
+    }
+    frame.box_scratch_->distribute(lazy, camera, decided, boxes);
+    box_order = frame.box_scratch_.get();
+  }
+
   // Pass 4, the order of the draw: the decided tree, less what occlusion found hidden.
   auto& leaves = frame.leaves_;
   leaves.clear();
@@ -955,11 +1018,20 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // lies outside the view frustum is left out (GL would clip all of it away), each box tested
   // only against the planes its parent's box straddles.
   // Every slot emitted is built: above and outside slots when merged, low ones by pass 4.
-  auto emit_store = [&](const BspStore& store) {
+  // Colour boxes put in a slot's BSP come out at the empty sides of its nodes; such a slot is
+  // drawn without leaving out subtrees by their boxes (which hold its own polygons only).
+  frame.transient_base = static_cast<std::uint32_t>(m.positions.size());
+  const auto emit_boxes = [&](std::int32_t bucket) {
+    box_order->emit_bucket(bucket, e, back_to_front, frame);
+    for (const BoxScratch::Tri& t : box_order->tris) emit(t.a, t.b, t.c, t.level);
+  };
+  auto emit_store = [&](const BspStore& store, std::int32_t slot) {
     auto& st = frame.leaf_stack_;
     st.clear();
-    // Items: node index, bit 31 set to emit the node's own polygons, bits 32-36 the planes left.
-    constexpr std::uint64_t kEmitBit = std::uint64_t{1} << 31;
+    const bool boxed = box_order && box_order->in_slot(slot);
+    // Items: node index, bit 31 set to emit the node's own polygons, bits 32-36 the planes left;
+    // or with bit 40 a bucket of boxes.
+    constexpr std::uint64_t kEmitBit = std::uint64_t{1} << 31, kBoxBit = std::uint64_t{1} << 40;
     const auto push_node = [&](std::int32_t node, int mask) {
       if (node < 0) return;
       if (options.cull && mask != 0) {
@@ -977,10 +1049,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       }
       st.push_back(static_cast<std::uint64_t>(node) | static_cast<std::uint64_t>(mask) << 32);
     };
-    push_node(store.root, 31);
+    if (boxed && store.root < 0) {
+      if (const std::int32_t b = box_order->bsp(slot, BoxScratch::kRootless, 0); b >= 0) emit_boxes(b);
+    }
+    push_node(store.root, boxed ? 0 : 31);
     while (!st.empty()) {
       const std::uint64_t item = st.back();
       st.pop_back();
+      if (item & kBoxBit) {
+        emit_boxes(static_cast<std::int32_t>(item & (kEmitBit - 1)));
+        continue;
+      }
       const auto node = static_cast<std::size_t>(item & (kEmitBit - 1));
       const BspNode& bn = store.nodes[node];
       if (item & kEmitBit) {
@@ -993,11 +1072,22 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       }
       const int mask = static_cast<int>(item >> 32);
       const bool eye_front = glm::dot(glm::dvec3(bn.n), e) + static_cast<double>(bn.d) >= 0.0;
-      const std::int32_t far_side = eye_front ? bn.back : bn.front, near_side = eye_front ? bn.front : bn.back;
-      const std::int32_t first = back_to_front ? far_side : near_side, second = back_to_front ? near_side : far_side;
-      push_node(second, mask);
+      // The side drawn first (1: front): the far one for back to front.
+      const int first_side = eye_front != back_to_front ? 1 : 0;
+      // An empty side (-1) may hold boxes.
+      const auto push_side = [&](int side) {
+        const std::int32_t child = side ? bn.front : bn.back;
+        if (boxed && child == -1) {
+          if (const std::int32_t b = box_order->bsp(slot, static_cast<std::int32_t>(node), side); b >= 0) {
+            st.push_back(kBoxBit | static_cast<std::uint64_t>(b));
+          }
+          return;
+        }
+        push_node(child, mask);
+      };
+      push_side(1 - first_side);
       st.push_back(kEmitBit | item);
-      push_node(first, mask);
+      push_side(first_side);
     }
   };
   // A drawn cell's walls: on each window side the eye lies beyond and the cell touches, the
@@ -1019,7 +1109,11 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   };
   for (const std::uint64_t item : leaves) {
     if (kind_of(item) == kEmitSlot) {
-      emit_store(*m.slots[static_cast<std::size_t>(slot_of(item))].store);
+      emit_store(*m.slots[static_cast<std::size_t>(slot_of(item))].store, slot_of(item));
+      continue;
+    }
+    if (kind_of(item) == kEmitBoxes) {
+      emit_boxes(slot_of(item));
       continue;
     }
     const int level = level_index_of(item) - m.top;
@@ -1045,14 +1139,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
 
     const CellContent* content = content_of(level, ci, cj);
     if (content && content->low >= 0) {
-      emit_store(*m.slots[static_cast<std::size_t>(content->low)].store);
+      emit_store(*m.slots[static_cast<std::size_t>(content->low)].store, content->low);
     } else {
       // The diagonal sw-ne separates (sw, se, ne) on its south-east side from (sw, ne, nw).
       const double side = (m.xs[static_cast<std::size_t>(i1)] - m.xs[static_cast<std::size_t>(i0)]) * (e.y - m.ys[static_cast<std::size_t>(j0)]) -
                           (m.ys[static_cast<std::size_t>(j1)] - m.ys[static_cast<std::size_t>(j0)]) * (e.x - m.xs[static_cast<std::size_t>(i0)]);
       const bool eye_south_east = side < 0;
       const auto lvl = static_cast<std::int8_t>(level);
-      if (eye_south_east == back_to_front) {  // draw the north-west triangle first
+      if (box_order && box_order->leaf(level_index_of(item), ci, cj)) {  // with colour boxes above the triangles
+        box_order->emit_leaf(m, level_index_of(item), ci, cj, e, eye_south_east, back_to_front, frame);
+        for (const BoxScratch::Tri& t : box_order->tris) emit(t.a, t.b, t.c, t.level);
+      } else if (eye_south_east == back_to_front) {  // draw the north-west triangle first
         emit(sw, ne, nw, lvl);
         emit(sw, se, ne, lvl);
       } else {
@@ -1064,6 +1161,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   }
   frame.indices.resize(3 * triangles);
   frame.level.resize(triangles);
+  if (box_order) frame.boxes = box_order->stats;
 }
 
 }  // namespace terravol::mrbsp

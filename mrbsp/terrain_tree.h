@@ -14,11 +14,15 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "mrbsp/color_boxes.h"
+
 namespace terravol::coverage {
 class Pyramid;
 }
 
 namespace terravol::mrbsp {
+
+struct BoxScratch;  // mrbsp/box_order.h
 
 // The terrain window, in the scene frame (metres). Samples form an (n+1) x (n+1) lattice,
 // n = 2^k cells per side: column i lies on the plane x = xs[i], row j on y = ys[j] (row 0
@@ -141,7 +145,10 @@ struct OcclusionStats {
 };
 
 // What one traversal produced. Triangles are index triples into TerrainTree::positions(),
-// in draw order. level[t] is the LOD level of triangle t, kCrackLevel or kMergedLevel.
+// in draw order. level[t] is the LOD level of triangle t, kCrackLevel, kMergedLevel,
+// kWallLevel or kBoxLevel. The faces of colour boxes (traverse() with boxes) use vertices of
+// their own: index transient_base + k is transient_positions[k], coloured transient_colors[k]
+// (transient_base is positions().size() when the traversal ended).
 struct Frame {
   std::vector<std::uint32_t> indices;  // 3 per triangle
   std::vector<std::int8_t> level;      // 1 per triangle
@@ -151,6 +158,10 @@ struct Frame {
   std::size_t balanced_cells = 0;   // cells refined only to keep neighbours within one level
   std::vector<std::size_t> lod_histogram;  // leaves drawn per level
   OcclusionStats occlusion;
+  std::vector<glm::vec3> transient_positions;
+  std::vector<glm::u8vec4> transient_colors;
+  std::uint32_t transient_base = 0;
+  BoxStats boxes;
 
   Frame();
   ~Frame();
@@ -163,7 +174,7 @@ struct Frame {
   std::vector<std::uint64_t> outside_order_;  // the window and the outside bands, in draw order
   struct OutsideOrder {
     double band_distance, column_distance;
-    std::int32_t slot;
+    std::uint64_t item;  // the walk's: an outside slot, or a bucket of colour boxes
   };
   std::vector<OutsideOrder> outside_places_;
   std::vector<std::uint64_t> leaf_stack_;
@@ -173,6 +184,7 @@ struct Frame {
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it
   std::uint32_t current_stamp_ = 0;
   int occlusion_backoff_ = 0;  // traversals still to leave the occlusion pass out of
+  std::unique_ptr<BoxScratch> box_scratch_;  // the colour boxes' buckets (mrbsp/color_boxes.cpp)
 };
 
 class TerrainTree {
@@ -209,7 +221,16 @@ class TerrainTree {
   // first time since the last merge gets its merged pieces built then (positions() and
   // merged_colors() grow by its vertices; merge_stats() counts it): traverse() changes the
   // tree's merged storage, so it must not run on two threads at once.
-  void traverse(const Camera& camera, const TraversalOptions& options, Frame& frame) const;
+  // Colour boxes (mrbsp/color_boxes.h), given in an order in which no box comes before a box
+  // it can hide (an octree's back-to-front order for this eye; front_to_back reverses it as
+  // it reverses everything), are drawn as their faces that face the eye, in the same exact
+  // order: each piece of a box is ordered against the terrain and the merged pieces by the
+  // tree's planes (the window's sides, the cells' split planes, the plane z = zmax of each
+  // cell entered, its triangles or the small BSP of a drawn cell), and faces below the terrain
+  // are dropped (mrbsp/color_boxes.cpp gives the argument). The tree is not changed (but for
+  // the low alternatives' pieces built on first use, as above). Frame::boxes says what it cost.
+  void traverse(const Camera& camera, const TraversalOptions& options, Frame& frame,
+                std::span<const ColorBox> boxes = {}) const;
 
   // Sliding (section 4.3): replace the heights and plane offsets for a window moved over the
   // terrain by whole coarse cells. When the plane offsets and heights of the samples the two

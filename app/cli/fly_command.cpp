@@ -28,6 +28,7 @@
 #include "app/scene/mosaic_lattice.h"
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
+#include "density/transfer.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::cli {
@@ -51,6 +52,8 @@ struct FlyOptions {
   RendererChoice drawn;  // --renderer, --aa
   bool resume = false, force = false;
   std::vector<std::string> objects;  // --object, added to the scene's
+  std::string density;               // --density: replaces every volume's density style
+  std::optional<double> density_threshold;
 };
 
 bool is_video(const std::filesystem::path& p) {
@@ -108,6 +111,10 @@ void run_fly(const FlyOptions& o) {
     if (!std::filesystem::exists(v.file)) throw std::invalid_argument(source + ": scene: " + v.file.string() + ": no such file");
   }
   for (scene::ObjectSpec& obj : parse_objects(o.objects)) scene.objects.push_back(std::move(obj));
+  if (!o.density.empty()) {
+    const density::DensitySpec d = density::parse_density(o.density);
+    for (scene::VolumeSpec& v : scene.volumes) v.density = d;
+  }
   // Size and LOD: --size and --threshold over the scene's "render" object over the defaults.
   scene::SceneStyle given;
   if (!o.size.empty()) {
@@ -117,6 +124,7 @@ void run_fly(const FlyOptions& o) {
     given.height = h;
   }
   given.threshold = o.threshold;
+  given.density_threshold = o.density_threshold;
   const scene::SceneStyle style = scene::overlay(scene.style, given);
   const scene::Style st = scene::resolve_style(style);
   const int width = st.width, height = st.height;
@@ -246,6 +254,7 @@ void run_fly(const FlyOptions& o) {
   render::SceneOptions scene_opts = render::scene_options(st);
   scene_opts.engine = o.drawn.engine;
   scene_opts.tiler.aa = o.drawn.aa;
+  scene_opts.density.threshold_px *= factor;  // in output pixels, like the LOD threshold
   render::SceneRenderer renderer(std::move(mosaic), scene, settings, scene_opts);
 
   const scene::CameraPath path(
@@ -348,7 +357,7 @@ void add_fly_command(CLI::App& app) {
                                         "(VTK needs an X display, --renderer tiler does not; docs/camera-paths.md)");
   auto o = std::make_shared<FlyOptions>();
   struct Raw {
-    double threshold = 0, start = 0, end = 0;
+    double threshold = 0, start = 0, end = 0, density_threshold = 0;
     RendererArgs renderer;
   };
   auto raw = std::make_shared<Raw>();
@@ -358,6 +367,8 @@ void add_fly_command(CLI::App& app) {
   cmd->add_option("--size", o->size, "Frame size WIDTHxHEIGHT, pixels (default: the scene's, else 1280x720)");
   auto* threshold = cmd->add_option("--threshold", raw->threshold,
                                     "LOD threshold in pixels for keys without their own (default: the scene's, else 2)");
+  add_density_option(*cmd, o->density);
+  auto* density_threshold = add_density_threshold_option(*cmd, raw->density_threshold);
   cmd->add_option("--crf", o->crf, "H.264 quality, 0 (lossless) .. 51 (worst)")->capture_default_str();
   auto* start = cmd->add_option("--start", raw->start, "First time to export, seconds on the path's clock");
   auto* end = cmd->add_option("--end", raw->end, "Last time to export, seconds on the path's clock");
@@ -370,7 +381,7 @@ void add_fly_command(CLI::App& app) {
                   "the size and box-filtered down)")
       ->capture_default_str();
   add_renderer_options(*cmd, raw->renderer);
-  cmd->callback([o, raw, threshold, start, end] {
+  cmd->callback([o, raw, threshold, start, end, density_threshold] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
     if (o->samples != 1 && o->samples != 4 && o->samples != 9 && o->samples != 16) {
@@ -388,6 +399,8 @@ void add_fly_command(CLI::App& app) {
       }
       o->threshold = raw->threshold;
     }
+    if (density_threshold->count() > 0) o->density_threshold = raw->density_threshold;
+    if (!o->density.empty()) density::parse_density(o->density);  // bad text fails before any work
     if (start->count() > 0) o->start = raw->start;
     if (end->count() > 0) o->end = raw->end;
     if (!o->size.empty()) {

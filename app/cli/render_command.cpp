@@ -121,6 +121,14 @@ void run_render(const RenderOptions& o) {
                 merge.input_triangles, merge.geometry_ms, merge.tree_triangles, merge.merge_ms, f.merged_triangles,
                 f.triangles);
   }
+  const scene::DensityFigures density = view.volumes().density_figures();
+  if (density.drawn) {
+    std::printf("density: %d x %d x %d leaves, %d levels, built in %.0f ms (%.0f MB); %zu cells drawn as %zu faces "
+                "(%zu triangles), refined in %.1f ms, ordered in %.1f ms\n",
+                density.grid.boxes[0], density.grid.boxes[1], density.grid.boxes[2], density.levels, density.build_ms,
+                static_cast<double>(density.bytes) / 1048576.0, f.density.boxes, f.boxes.faces, f.box_triangles, f.density_ms,
+                f.boxes.distribute_ms);
+  }
   const scene::ObjectFigures& objects = view.objects().figures();
   if (objects.instances > 0) {
     std::printf("objects: %zu instances of %zu models read in %.0f ms, levels made in %.0f ms; %zu of %zu triangles "
@@ -203,6 +211,20 @@ void run_render(const RenderOptions& o) {
                     {"read_ms", objects.read_ms},
                     {"lod_ms", objects.lod_ms},
                     {"first_merge_ms", first.objects_ms}};
+    j["density"] = {{"drawn", density.drawn},
+                    {"threshold_px", view.density_options().threshold_px},
+                    {"leaves", density.grid.boxes},
+                    {"levels", density.levels},
+                    {"bytes", density.bytes},
+                    {"resample_ms", density.resample_ms},
+                    {"build_ms", density.build_ms},
+                    {"cells", f.density.boxes},
+                    {"cells_per_level", f.density.per_level},
+                    {"faces", f.boxes.faces},
+                    {"triangles", f.box_triangles},
+                    {"bsp_faces", f.boxes.bsp_faces},
+                    {"refine_ms", f.density_ms},
+                    {"order_ms", f.boxes.distribute_ms}};
     j["camera"] = {{"lat", o.pose.lat},
                    {"lon", o.pose.lon},
                    {"eye_height", f.eye_height},

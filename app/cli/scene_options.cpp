@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "density/transfer.h"
 #include "volume/geometry.h"
 #include "volume/volume.h"
 
@@ -22,6 +23,7 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
   cmd.add_option("--slice", args.slices,
                  "Slice lat|lon|alt|agl=VALUE[,colormap=NAME][,opacity=A][,range=LO:HI] of every --volume (as --iso); "
                  "repeatable");
+  add_density_option(cmd, args.density);
   add_object_option(cmd, args.objects);
   cmd.add_flag("--no-legend", args.no_legend, "No colour legend for the volumes");
   cmd.add_flag("--no-markers", args.no_markers, "No marker at the transmitters the volumes record");
@@ -65,6 +67,8 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
   s.occlusion_option = option("--occlusion", s.occlusion,
                               "Occlusion culling of hidden terrain and volumes (Greene's coverage masks): on or off; "
                               "the image is the same either way");
+  s.density_threshold = defaults.density_threshold;
+  s.density_threshold_option = add_density_threshold_option(cmd, s.density_threshold)->capture_default_str();
   s.coherence_option = option("--coherence", s.coherence,
                               "Occlusion tests reused from frame to frame (Bittner and Havran): off, update or "
                               "conservative; with --occlusion on");
@@ -75,6 +79,18 @@ CLI::Option* add_object_option(CLI::App& cmd, std::vector<std::string>& objects)
                         "3D model (glTF, OBJ, PLY, STL, FBX, ... read by assimp) placed on the terrain: "
                         "FILE@LAT,LON,AGL[,heading=DEG][,pitch=DEG][,roll=DEG][,scale=S][,opacity=A][,up=y|z] "
                         "(AGL metres above the ground; docs/scene-file.md, \"objects\"); repeatable");
+}
+
+CLI::Option* add_density_option(CLI::App& cmd, std::string& density) {
+  return cmd.add_option("--density", density,
+                        "Draw the volumes as a density of colour cubes: range=LO:HI,colormap=NAME,opacity=SIGMA_PER_KM"
+                        "[,ramp=flat|up|down] (values outside LO..HI clear; extinction per km; docs/scene-file.md)");
+}
+
+CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold) {
+  return cmd.add_option("--density-threshold", threshold,
+                        "Density: a colour cube is drawn as its faces once its largest side spans fewer pixels than "
+                        "this (epsilon; in view, keys E and Shift+E)");
 }
 
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts) {
@@ -131,6 +147,7 @@ scene::SceneStyle given_style(const SceneArgs& args) {
   if (given(s.surface_option)) g.surface_triangles = s.surface_triangles;
   if (given(s.occlusion_option)) g.occlusion = s.occlusion;
   if (given(s.coherence_option)) g.coherence = s.coherence;
+  if (given(s.density_threshold_option)) g.density_threshold = s.density_threshold;
   if (args.no_legend) g.legend = false;
   if (args.no_markers) g.markers = false;
   return g;
@@ -155,11 +172,14 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
   for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
   std::vector<volume::SliceSpec> slice_specs;
   for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
+  std::optional<density::DensitySpec> density;
+  if (!args.density.empty()) density = density::parse_density(args.density);
   for (scene::ObjectSpec& o : parse_objects(args.objects)) scene.objects.push_back(std::move(o));
   if (args.volumes.empty()) {
     for (scene::VolumeSpec& v : scene.volumes) {
       if (!iso_specs.empty()) v.isosurfaces = iso_specs;
       if (!slice_specs.empty()) v.slices = slice_specs;
+      if (density) v.density = density;
     }
     return scene;
   }
@@ -170,6 +190,7 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
     v.frame = frame;
     v.isosurfaces = iso_specs;
     v.slices = slice_specs;
+    v.density = density;
     scene.volumes.push_back(std::move(v));
   }
   return scene;

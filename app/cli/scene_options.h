@@ -16,25 +16,26 @@
 namespace terravol::app::cli {
 
 // The style options as given: --size, --lod-metric, --threshold, --order, --tint, --window,
-// --haze, --sun-azimuth, --sun-elevation, --surface-triangles, --occlusion, --coherence. The values start at
+// --haze, --sun-azimuth, --sun-elevation, --surface-triangles, --occlusion, --coherence, --density-threshold. The values start at
 // scene::Style's defaults (shown in --help); only the options given count (given_style).
 struct StyleArgs {
   std::string size, metric, order, tint, occlusion, coherence;
-  double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0;
+  double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0, density_threshold = 0.0;
   int window = 0;
   std::size_t surface_triangles = 0;
   CLI::Option *size_option = nullptr, *metric_option = nullptr, *threshold_option = nullptr,
               *order_option = nullptr, *tint_option = nullptr, *window_option = nullptr, *haze_option = nullptr,
               *sun_azimuth_option = nullptr, *sun_elevation_option = nullptr, *surface_option = nullptr,
-              *occlusion_option = nullptr, *coherence_option = nullptr;
+              *occlusion_option = nullptr, *coherence_option = nullptr, *density_threshold_option = nullptr;
 };
 
-// The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --object,
-// --no-legend and the style options.
+// The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --density,
+// --object, --no-legend and the style options.
 struct SceneArgs {
   std::filesystem::path scene;
   std::vector<std::filesystem::path> volumes;
   std::vector<std::string> isos, slices, objects;
+  std::string density;  // --density text; empty: none given
   std::string volume_frame, field;
   bool no_legend = false, no_markers = false;
   StyleArgs style;
@@ -43,6 +44,10 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args);
 // --object FILE@LAT,LON,AGL[,heading=..][,pitch=..][,roll=..][,scale=..][,opacity=..][,up=y|z]
 // (render, view and fly share it).
 CLI::Option* add_object_option(CLI::App& cmd, std::vector<std::string>& objects);
+// --density RANGE...: render, view and fly share its help (docs/scene-file.md, "density").
+CLI::Option* add_density_option(CLI::App& cmd, std::string& density);
+// --density-threshold PIXELS (epsilon of the colour cubes).
+CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold);
 // The scene objects of --object texts (scene::parse_object; the files are read later).
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts);
 
@@ -71,10 +76,10 @@ scene::SceneStyle given_style(const SceneArgs& args);
 // replaced by `dems` when not empty (else `dems` gets the file's; none at all is an error),
 // its style overlaid with given_style (the options win), and its volumes joined with the
 // --volume files: each --volume FILE (read as --field, placed by --volume-frame) gets the
-// --iso and --slice styles; with no --volume, non-empty --iso or --slice lists replace the
-// styles of every volume of the file; each --object (scene::parse_object) joins the file's
-// objects. Throws std::invalid_argument for a bad file or bad --iso, --slice, --object,
-// --volume-frame or --size text.
+// --iso, --slice and --density styles; with no --volume, non-empty --iso or --slice lists, or
+// a --density, replace the styles of every volume of the file; each --object
+// (scene::parse_object) joins the file's objects. Throws std::invalid_argument for a bad file
+// or bad --iso, --slice, --density, --object, --volume-frame or --size text.
 scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
 
 }  // namespace terravol::app::cli

@@ -5,6 +5,9 @@
 #include <vtkDataSetAttributes.h>
 #include <vtkObjectFactory.h>
 #include <vtkOpenGLIndexBufferObject.h>
+#include <vtkOpenGLVertexBufferObject.h>
+#include <vtkOpenGLVertexBufferObjectGroup.h>
+#include <vtkPoints.h>
 #include <vtkOpenGLRenderWindow.h>
 #include <vtkOpenGLState.h>
 #include <vtkPointData.h>
@@ -66,6 +69,46 @@ void OrderedPolyDataMapper::BuildIBO(vtkRenderer* ren, vtkActor* act, vtkPolyDat
   ibo->Upload(reinterpret_cast<const unsigned int*>(ids->GetPointer(0)), count,
               vtkOpenGLBufferObject::ElementArrayBuffer);
   ibo->IndexCount = count;
+}
+
+void OrderedPolyDataMapper::BuildBufferObjects(vtkRenderer* ren, vtkActor* act) {
+  Superclass::BuildBufferObjects(ren, act);
+  if (update_count_ == 0) return;
+  const std::size_t first = update_first_, count = update_count_;
+  update_count_ = 0;
+  vtkPolyData* poly = this->CurrentInput;
+  if (poly == nullptr || poly->GetPoints() == nullptr) return;
+  // Positions: as VTK packs them (3 floats a vertex, shifted and scaled when it does so).
+  if (vtkOpenGLVertexBufferObject* vbo = this->VBOs->GetVBO("vertexMC")) {
+    auto* points = static_cast<const float*>(poly->GetPoints()->GetData()->GetVoidPointer(0));
+    const unsigned stride = vbo->GetStride();
+    const bool shifted = vbo->GetCoordShiftAndScaleEnabled();
+    const float* data = points + 3 * first;
+    if (shifted || stride != 3 * sizeof(float)) {
+      const std::size_t per = stride / sizeof(float);
+      packed_.assign(per * count, 0.0f);
+      const std::vector<double>& shift = vbo->GetShift();
+      const std::vector<double>& scale = vbo->GetScale();
+      for (std::size_t v = 0; v < count; ++v)
+        for (std::size_t a = 0; a < 3; ++a) {
+          const double p = points[3 * (first + v) + a];
+          packed_[per * v + a] = static_cast<float>(shifted ? (p - shift[a]) * scale[a] : p);
+        }
+      data = packed_.data();
+    }
+    vbo->Bind();
+    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * stride), static_cast<GLsizeiptr>(count * stride), data);
+    vbo->Release();
+  }
+  // Colours: RGBA bytes (absent when the colours are per cell, --lod-colors).
+  vtkDataArray* scalars = poly->GetPointData()->GetScalars();
+  vtkOpenGLVertexBufferObject* colours = this->VBOs->GetVBO("scalarColor");
+  if (colours != nullptr && scalars != nullptr && colours->GetStride() == 4) {
+    colours->Bind();
+    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * 4), static_cast<GLsizeiptr>(count * 4),
+                    static_cast<const unsigned char*>(scalars->GetVoidPointer(0)) + 4 * first);
+    colours->Release();
+  }
 }
 
 void OrderedPolyDataMapper::RenderPieceFinish(vtkRenderer* ren, vtkActor* act) {

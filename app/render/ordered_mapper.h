@@ -8,6 +8,8 @@
 #include <vtkPolyData.h>
 
 #include <array>
+#include <cstddef>
+#include <vector>
 
 namespace terravol::app::render {
 
@@ -38,6 +40,17 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   void set_blending(bool on) { blending_ = on; }
   bool blending() const { return blending_; }
 
+  // Vertices [first, first + count) of the input changed their positions and colours only
+  // (a frame's colour-box faces, TerrainRenderer::set_frame): the next draw writes them into
+  // the vertex buffers in place (glBufferSubData), as the input's point and scalar arrays hold
+  // them, instead of VTK uploading every vertex again. The caller does not mark those arrays
+  // modified (which would upload everything anyway); the range must lie within the vertices
+  // VTK last uploaded.
+  void update_vertices(std::size_t first, std::size_t count) {
+    update_first_ = first;
+    update_count_ = count;
+  }
+
   OrderedPolyDataMapper(const OrderedPolyDataMapper&) = delete;
   OrderedPolyDataMapper& operator=(const OrderedPolyDataMapper&) = delete;
 
@@ -45,9 +58,12 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   OrderedPolyDataMapper() = default;
   ~OrderedPolyDataMapper() override = default;
   void BuildIBO(vtkRenderer* ren, vtkActor* act, vtkPolyData* poly) override;
+  void BuildBufferObjects(vtkRenderer* ren, vtkActor* act) override;
 
  private:
   bool blending_ = true;
+  std::size_t update_first_ = 0, update_count_ = 0;
+  std::vector<float> packed_;  // update_vertices' positions when VTK shifts and scales them
   bool saved_depth_test_ = true;
   bool saved_blend_ = false;
   std::array<int, 4> saved_blend_func_{};

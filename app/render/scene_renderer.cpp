@@ -13,6 +13,9 @@
 #include <malloc.h>
 #endif
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
 #include "app/scene/ground_grid.h"
 #include "app/scene/mosaic_lattice.h"
 #include "app/scene/profile_path.h"
@@ -51,6 +54,7 @@ SceneOptions scene_options(const scene::Style& style, int levels, Sliding slidin
   o.markers = style.markers;
   o.surface_triangles = style.surface_triangles;
   o.sliding = sliding;
+  o.density.threshold_px = style.density_threshold;
   return o;
 }
 
@@ -70,13 +74,16 @@ SceneRenderer::SceneRenderer(const scene::SceneSpec& scene, const RenderSettings
 
 SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, const RenderSettings& settings,
                              const SceneOptions& options)
-    : mosaic_(std::move(mosaic)), settings_(settings), options_(options) {
+    : mosaic_(std::move(mosaic)), settings_(settings), options_(options), density_options_(options.density) {
   const scene::CameraPose at = scene.camera ? scene.camera->pose : scene::default_pose(mosaic_);
   scene::require_near(mosaic_, at.lat, at.lon);
   if (options_.engine == scene::Engine::kTiler) {
     if (settings_.order != scene::DrawOrder::kBsp || settings_.wireframe || settings_.lod_colors) {
       throw std::invalid_argument("the tiler draws filled triangles in the tree's order only (--order bsp, no "
                                   "--wireframe or --lod-colors)");
+    }
+    for (const scene::VolumeSpec& v : scene.volumes) {
+      if (v.density) throw std::invalid_argument("the tiler does not draw densities (--renderer vtk draws them)");
     }
     options_.tiler.width = settings_.width;
     options_.tiler.height = settings_.height;
@@ -316,9 +323,25 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
     const int aa = tiled_->settings().aa;
     scene_->tree().traverse(tiled_traversal_camera(camera_, traversal, aa), tiled_traversal(traversal, aa), frame_);
   } else {
-    scene_->tree().traverse(camera_, traversal, frame_);
+    boxes_.clear();
+    volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+    if (!boxes_.empty()) {
+      // The far plane holds the density's cells too (they may lie beyond the window).
+      const double window_far = scene_->far_plane(camera_.eye);
+      double far = 0.0;
+      for (const mrbsp::ColorBox& b : boxes_) {
+        const glm::dvec3 d = glm::max(glm::abs(glm::dvec3(b.lo) - camera_.eye), glm::abs(glm::dvec3(b.hi) - camera_.eye));
+        far = std::max(far, glm::dot(d, d));
+      }
+      far = std::sqrt(far) * 1.05 + 100.0;
+      if (far > window_far) renderer_->set_camera(camera_, far);
+    }
+    stats.density_ms = ms_since(t0);
+    t0 = Clock::now();
+    scene_->tree().traverse(camera_, traversal, frame_, boxes_);
   }
   stats.traversal_ms = ms_since(t0);
+  stats.boxes = frame_.boxes;
   t0 = Clock::now();
   if (renderer_) {
     sync_vertices(*renderer_);  // the low alternatives the traversal built appended vertices
@@ -328,6 +351,8 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   stats.triangles = frame_.indices.size() / 3;
   stats.merged_triangles = static_cast<std::size_t>(
       std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kMergedLevel)));
+  stats.box_triangles = static_cast<std::size_t>(
+      std::count(frame_.level.begin(), frame_.level.end(), static_cast<std::int8_t>(mrbsp::kBoxLevel)));
   stats.nodes_visited = frame_.nodes_visited;
   return stats;
 }

@@ -42,6 +42,12 @@ struct FrameStats {
   double eye_height = 0, ground_height = 0;  // metres, DEM datum
   double objects_ms = 0;          // choosing the objects' levels and merging those that changed
   std::size_t objects_merged = 0; // instances merged again this frame
+  // The density (colour cubes; VolumeLayer::density_boxes): refining the octree, the cells
+  // drawn, and what ordering them in the tree cost (mrbsp::BoxStats).
+  double density_ms = 0;
+  density::RefineStats density;
+  mrbsp::BoxStats boxes;
+  std::size_t box_triangles = 0;  // of triangles: the boxes' faces
 };
 
 // When the window slides, once the camera is within a quarter of its side of an edge.
@@ -65,6 +71,7 @@ struct SceneOptions {
   // without wireframe or LOD colours.
   scene::Engine engine = scene::Engine::kVtk;
   tiler::Settings tiler;  // kTiler: aa, texel rate, bands, threads (the size is the RenderSettings')
+  density::RefineOptions density;  // how the density is refined (threshold: epsilon, pixels)
 };
 
 // The pipeline's options and the renderer's settings as a resolved style gives them (window,
@@ -127,6 +134,11 @@ class SceneRenderer {
   // The slide prepare() would make for a camera at `pose`, without a frame (terravol fly
   // --resume makes the slides of the frames it skips). Returns whether the window moved.
   bool slide_for(const scene::CameraPose& pose);
+
+  // How densities are refined (density::RefineOptions: epsilon, or every leaf); from the next
+  // prepare().
+  void set_density_options(const density::RefineOptions& options) { density_options_ = options; }
+  const density::RefineOptions& density_options() const { return density_options_; }
 
   // The eye's height in the DEM's datum for `pose` (pose.alt plus the ground under it when agl).
   // Throws std::runtime_error("camera at H m is not above the ground (G m there)...") when it is
@@ -238,6 +250,8 @@ class SceneRenderer {
   double far_plane_ = 0;                       // kTiler: of the prepared frame
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
+  density::RefineOptions density_options_;
+  std::vector<mrbsp::ColorBox> boxes_;  // the density's cells of the last frame
   bool auto_slide_ = true;
   int slides_ = 0;
   SlideFigures last_slide_;

@@ -287,7 +287,71 @@ vtkSmartPointer<vtkCellArray> triangle_cells(std::span<const std::uint32_t> indi
   return polys;
 }
 
+void TerrainRenderer::reserve_tail(std::size_t capacity) {
+  const std::size_t n = point_rgba_.size();
+  const auto count = static_cast<vtkIdType>(n + capacity);
+  vtkPointData* pd = poly_->GetPointData();
+  const auto resize = [&](vtkDataArray* a) {
+    if (a == nullptr) return;
+    if (a->GetSize() < count * a->GetNumberOfComponents()) a->Resize(count);
+    a->SetNumberOfTuples(count);
+    a->Modified();
+  };
+  vtkDataArray* xyz = poly_->GetPoints()->GetData();
+  for (vtkDataArray* a : {xyz, pd->GetNormals(), pd->GetScalars(), pd->GetTCoords()}) resize(a);
+  auto* p = static_cast<float*>(xyz->GetVoidPointer(0));
+  std::fill(p + 3 * n, p + 3 * (n + capacity), 0.0f);
+  auto* nm = static_cast<float*>(pd->GetNormals()->GetVoidPointer(0));
+  for (std::size_t k = n; k < n + capacity; ++k) {
+    nm[3 * k] = 0.0f;
+    nm[3 * k + 1] = 0.0f;
+    nm[3 * k + 2] = 1.0f;
+  }
+  auto* c = static_cast<unsigned char*>(pd->GetScalars()->GetVoidPointer(0));
+  std::fill(c + 4 * n, c + 4 * (n + capacity), static_cast<unsigned char>(0));
+  if (pd->GetTCoords() != nullptr) {
+    auto* t = static_cast<float*>(pd->GetTCoords()->GetVoidPointer(0));
+    std::fill(t + 2 * n, t + 2 * (n + capacity), -1.0f);
+  }
+  poly_->GetPoints()->Modified();
+  poly_->Modified();
+  if (split_orders()) merged_poly_->Modified();
+  tail_ = capacity;
+}
+
 void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
+  // The frame's own vertices (colour-box faces) into the tail after the tree's.
+  const std::size_t own = frame.transient_positions.size();
+  if (own > 0) {
+    if (frame.transient_base != point_rgba_.size()) {
+      throw std::invalid_argument("TerrainRenderer::set_frame: the frame's own vertices start at " +
+                                  std::to_string(frame.transient_base) + ", after " + std::to_string(point_rgba_.size()) +
+                                  " vertices of the tree here");
+    }
+    const bool grown = own > tail_;
+    if (grown) reserve_tail(std::max({own, 2 * tail_, std::size_t{4096}}));
+    const std::size_t base = point_rgba_.size();
+    vtkDataArray* xyz = poly_->GetPoints()->GetData();
+    std::memcpy(static_cast<float*>(xyz->GetVoidPointer(0)) + 3 * base, frame.transient_positions.data(), own * sizeof(glm::vec3));
+    std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * base,
+                frame.transient_colors.data(), own * sizeof(glm::u8vec4));
+    auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
+    if (ordered != nullptr && !grown) {
+      ordered->update_vertices(base, own);
+    } else {
+      xyz->Modified();
+      poly_->GetPoints()->Modified();
+      poly_->GetPointData()->GetScalars()->Modified();
+      if (split_orders()) merged_poly_->Modified();
+    }
+    if (ordered != nullptr && !ordered->blending()) {
+      for (const glm::u8vec4& c : frame.transient_colors) {
+        if (c.a == 255) continue;
+        ordered->set_blending(true);
+        break;
+      }
+    }
+  }
   // The split orders draw the merged triangles with a second actor: the terrain's list keeps
   // the rest, in the frame's order (buffers reused from frame to frame).
   const std::vector<std::uint32_t>* terrain = &frame.indices;
@@ -298,10 +362,11 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     split_levels_.clear();
     for (std::size_t t = 0; 3 * t < frame.indices.size(); ++t) {
       const int lv = t < frame.level.size() ? frame.level[t] : mrbsp::kCrackLevel;
-      auto& to = lv == mrbsp::kMergedLevel ? split_merged_ : split_terrain_;
+      const bool translucent = lv == mrbsp::kMergedLevel || lv == mrbsp::kBoxLevel;
+      auto& to = translucent ? split_merged_ : split_terrain_;
       to.insert(to.end(), frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
                 frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
-      if (lv != mrbsp::kMergedLevel) split_levels_.push_back(static_cast<std::int8_t>(lv));
+      if (!translucent) split_levels_.push_back(static_cast<std::int8_t>(lv));
     }
     terrain = &split_terrain_;
     levels = &split_levels_;
@@ -330,6 +395,11 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
       const std::uint32_t* v = &(*terrain)[static_cast<std::size_t>(3 * t)];
       if (lv == mrbsp::kCrackLevel) {
         rgba[t] = scene::kCrackColor;
+        continue;
+      }
+      if (lv == mrbsp::kBoxLevel) {  // box faces keep their own colour
+        const glm::u8vec4& c = frame.transient_colors[v[0] - frame.transient_base];
+        rgba[t] = {c.r, c.g, c.b, c.a};
         continue;
       }
       if (lv < 0) {  // merged polygons keep their own colour
@@ -449,6 +519,7 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   }
   shade_ = shading.shade;
   point_rgba_ = shading.rgba;
+  if (tail_ > 0) reserve_tail(tail_);  // the frames' own vertices after the new ones
   choose_blending(*mapper_, shading.rgba, texture.rgba);
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
@@ -486,6 +557,7 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   }
   shade_.resize(shade_.size() + positions.size(), 1.0f);
   point_rgba_.insert(point_rgba_.end(), rgba.begin(), rgba.end());
+  if (tail_ > 0) reserve_tail(tail_);  // the frames' own vertices after the new ones
   // Translucent newcomers turn blending on (it stays on: what was translucent still is).
   if (std::any_of(rgba.begin(), rgba.end(), [](const scene::Rgba& c) { return c[3] != 255; })) {
     if (auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_)) ordered->set_blending(true);
@@ -508,6 +580,7 @@ void TerrainRenderer::release_vertices() {
   poly_->GetPoints()->Modified();
   std::vector<float>().swap(shade_);
   std::vector<scene::Rgba>().swap(point_rgba_);
+  tail_ = 0;
   // The mappers' vertex and index buffers. The next render() builds them again, as it would
   // after replace_vertices() anyway; shader programs stay in the window's cache.
   window_->MakeCurrent();

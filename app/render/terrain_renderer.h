@@ -109,6 +109,13 @@ class TerrainRenderer {
 
   // Replaces the triangle list with the frame's, in its order (and, with lod_colors, the
   // per-triangle colours: lod_color(level) times the mean shade of the three vertices).
+  // The frame's own vertices (colour-box faces: Frame::transient_positions, from index
+  // transient_base) go after the tree's, in a tail of vertices reserved for them (grown, by
+  // doubling, when a frame needs more: that frame uploads every vertex again); otherwise
+  // only they are written to the vertex buffers (OrderedPolyDataMapper::update_vertices), or,
+  // for the other orders, everything is uploaded again. Throws std::invalid_argument when the
+  // frame's transient_base is not vertex_count() (the renderer holds other vertices than the
+  // tree that traversed).
   void set_frame(const mrbsp::Frame& frame);
 
   // Draws one frame and waits for the GPU to finish it; returns wall milliseconds.
@@ -136,7 +143,8 @@ class TerrainRenderer {
   // vertex_shading gives merged vertices). The triangles drawn stay valid. Throws
   // std::invalid_argument when the counts differ.
   void append_merged_vertices(std::span<const glm::vec3> positions, std::span<const glm::u8vec4> colors);
-  std::size_t vertex_count() const { return point_rgba_.size(); }
+  std::size_t vertex_count() const { return point_rgba_.size(); }  // the tree's, not the frame's own
+  std::size_t transient_capacity() const { return tail_; }
   // Which TerrainTree::merged_version() the vertices are of (the caller's bookkeeping:
   // SceneRenderer::sync_vertices sets it).
   std::uint64_t vertex_version() const { return vertex_version_; }
@@ -184,6 +192,10 @@ class TerrainRenderer {
   void update_legend();  // before each render: the card at its place and size
   const RgbaImage* legend_image_for(int max_height);
   void install_shaders(vtkActor& actor, bool textured);
+  // Makes the arrays hold vertex_count() + capacity vertices: the tree's, then placeholders
+  // for a frame's own (at the origin, clear, texture coordinates (-1, -1) so that the shader
+  // takes their colour) and marks them modified. Sets tail_.
+  void reserve_tail(std::size_t capacity);
   bool split_orders() const {
     return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer;
   }
@@ -191,6 +203,7 @@ class TerrainRenderer {
   RenderSettings settings_;
   std::vector<float> shade_;      // per vertex, for --lod-colors
   std::vector<scene::Rgba> point_rgba_;  // per vertex, for merged polygons under --lod-colors
+  std::size_t tail_ = 0;          // vertices reserved after the tree's for a frame's own
   int texture_side_ = 0;          // 0: no texture
   std::uint64_t vertex_version_ = ~std::uint64_t{0};
   vtkNew<vtkPolyData> poly_;

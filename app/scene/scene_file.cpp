@@ -81,12 +81,40 @@ volume::SliceSpec slice_of(const Reader& r, const json& j, const std::string& wh
   return s;
 }
 
+// {"range": [LO, HI], "colormap": NAME, "opacity": SIGMA_PER_KM, "ramp": "flat" | "up" | "down"}:
+// the same keys and checks as --density (density::parse_density).
+density::DensitySpec density_of(const Reader& r, const json& j, const std::string& where) {
+  r.only_keys(j, where, {"range", "colormap", "opacity", "ramp"});
+  density::DensitySpec d;
+  const json& range = r.required(j, where, "range");
+  const std::string w = Reader::join(where, "range");
+  if (!range.is_array() || range.size() != 2) r.fail(w, "expected [LOW, HIGH]");
+  d.lo = static_cast<float>(r.number(range[0], Reader::at(w, 0), -1e30, 1e30));
+  d.hi = static_cast<float>(r.number(range[1], Reader::at(w, 1), -1e30, 1e30));
+  if (!(d.lo < d.hi)) r.fail(w, "LOW must be below HIGH");
+  d.colormap = r.string(r.required(j, where, "colormap"), Reader::join(where, "colormap"));
+  try {
+    d.colormap = std::string(volume::colormap_by_name(d.colormap).name());
+  } catch (const std::invalid_argument& e) {
+    r.fail(Reader::join(where, "colormap"), e.what());
+  }
+  d.sigma_per_km = r.number(r.required(j, where, "opacity"), Reader::join(where, "opacity"), 1e-9, 1e6);
+  if (j.contains("ramp")) {
+    try {
+      d.ramp = density::parse_ramp(r.string(j["ramp"], Reader::join(where, "ramp")));
+    } catch (const std::invalid_argument& e) {
+      r.fail(Reader::join(where, "ramp"), e.what());
+    }
+  }
+  return d;
+}
+
 // `isosurfaces_before`: how many isosurfaces the volumes before this one have (an isosurface
 // without a colour takes the palette's colour of its place among all of the file's, so that
 // the surfaces of different volumes differ); counted on.
 VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& base,
                      std::size_t& isosurfaces_before) {
-  r.only_keys(j, where, {"file", "field", "frame", "visible", "isosurfaces", "slices"});
+  r.only_keys(j, where, {"file", "field", "frame", "visible", "isosurfaces", "slices", "density"});
   if (!j.contains("file")) r.fail(where, "missing \"file\"");
   VolumeSpec v;
   v.file = resolve(base, r.string(j["file"], Reader::join(where, "file")));
@@ -100,6 +128,7 @@ VolumeSpec volume_of(const Reader& r, const json& j, const std::string& where, c
     }
   }
   if (j.contains("visible")) v.visible = r.boolean(j["visible"], Reader::join(where, "visible"));
+  if (j.contains("density")) v.density = density_of(r, j["density"], Reader::join(where, "density"));
   for (const char* list : {"isosurfaces", "slices"}) {
     if (!j.contains(list)) continue;
     const std::string w = Reader::join(where, list);
@@ -161,7 +190,8 @@ SceneCamera camera_of(const Reader& r, const json& j) {
 
 SceneStyle style_of(const Reader& r, const json& j) {
   r.only_keys(j, "render", {"size", "threshold", "lod_metric", "order", "tint", "window", "haze_km", "sun_azimuth",
-                            "sun_elevation", "legend", "markers", "surface_triangles", "occlusion", "coherence"});
+                            "sun_elevation", "legend", "markers", "surface_triangles", "occlusion", "coherence",
+                            "density_threshold"});
   SceneStyle s;
   auto text = [&](const char* key, auto check) -> std::optional<std::string> {
     if (!j.contains(key)) return std::nullopt;
@@ -184,6 +214,9 @@ SceneStyle style_of(const Reader& r, const json& j) {
     s.height = h;
   }
   if (j.contains("threshold")) s.threshold = r.number(j["threshold"], "render.threshold", 1e-3, 1e7);
+  if (j.contains("density_threshold")) {
+    s.density_threshold = r.number(j["density_threshold"], "render.density_threshold", kMinDensityThreshold, kMaxDensityThreshold);
+  }
   s.lod_metric = text("lod_metric", [](const std::string& v) { parse_metric(v); });
   s.order = text("order", [](const std::string& v) { parse_order(v); });
   s.tint = text("tint", [](const std::string& v) { parse_tint(v); });

@@ -13,6 +13,7 @@
 
 #include "app/scene/camera.h"
 #include "app/scene/style.h"
+#include "density/transfer.h"
 #include "objects/placement.h"
 #include "volume/geometry.h"
 
@@ -25,6 +26,8 @@ struct VolumeSpec {
   bool visible = true;
   std::vector<volume::IsoSpec> isosurfaces;
   std::vector<volume::SliceSpec> slices;
+  // Drawn as a density (colour cubes, density/octree.h) with this transfer function.
+  std::optional<density::DensitySpec> density;
 };
 
 // A model placed on the terrain (objects/). pose.height is metres above the ground under

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -31,7 +32,8 @@ constexpr auto kStyleKeys =
     std::make_tuple(&SceneStyle::width, &SceneStyle::height, &SceneStyle::threshold, &SceneStyle::lod_metric,
                     &SceneStyle::order, &SceneStyle::tint, &SceneStyle::window, &SceneStyle::haze_km,
                     &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend, &SceneStyle::markers,
-                    &SceneStyle::surface_triangles, &SceneStyle::occlusion, &SceneStyle::coherence);
+                    &SceneStyle::surface_triangles, &SceneStyle::occlusion, &SceneStyle::coherence,
+                    &SceneStyle::density_threshold);
 
 }  // namespace
 
@@ -59,6 +61,16 @@ Style resolve_style(const SceneStyle& s) {
   if (s.surface_triangles) r.surface_triangles = *s.surface_triangles;
   if (s.occlusion) r.traversal.occlusion = parse_on_off("--occlusion", *s.occlusion);
   if (s.coherence) r.traversal.coherence = parse_coherence(*s.coherence);
+  if (s.density_threshold) {
+    const double t = *s.density_threshold;
+    if (!(t >= kMinDensityThreshold && t <= kMaxDensityThreshold)) {
+      char b[128];
+      std::snprintf(b, sizeof b, "--density-threshold %g: expected pixels within [%g, %g]", t, kMinDensityThreshold,
+                    kMaxDensityThreshold);
+      throw std::invalid_argument(b);
+    }
+    r.density_threshold = t;
+  }
   return r;
 }
 

@@ -37,6 +37,12 @@ enum class Engine : std::uint8_t { kVtk, kTiler };
 // Isosurfaces are reduced to this many triangles each before merging (0: all); slices never.
 inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
 
+// Densities (density/octree.h): a colour cube is drawn as its faces when its largest side spans
+// fewer than this many pixels (epsilon; Chamberlain et al.'s cubes "project to no more than a
+// pixel"); the range the options, the scene file and the viewer's keys accept.
+inline constexpr double kDefaultDensityThreshold = 1.0;
+inline constexpr double kMinDensityThreshold = 0.25, kMaxDensityThreshold = 64.0;
+
 // The "render" object of a scene file (docs/scene-file.md), or what a command line gave: every
 // key optional; what is absent is decided by the next source (overlay) or the default
 // (resolve_style). Names (metric, order, tint) as the options spell them.
@@ -49,6 +55,7 @@ struct SceneStyle {
   std::optional<bool> legend, markers;
   std::optional<std::size_t> surface_triangles;
   std::optional<std::string> occlusion, coherence;
+  std::optional<double> density_threshold;
 };
 
 // A style with every key decided.
@@ -62,6 +69,7 @@ struct Style {
   bool legend = true;               // a colour legend when volumes are drawn
   bool markers = true;              // a marker at each transmitter a volume records
   std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface; 0: all
+  double density_threshold = kDefaultDensityThreshold;        // pixels (epsilon)
   // traversal.occlusion and traversal.coherence come from "occlusion" (on | off, default off)
   // and "coherence" (off | update | conservative, default off).
 };

@@ -110,6 +110,7 @@ struct VolumeLayer::Loaded {
   std::unique_ptr<volume::LatticeMapper> mapper;
   std::vector<volume::Mesh> isosurfaces, slices;
   volume::Mesh markers;  // its transmitters' masts (shown with markers_shown_)
+  std::unique_ptr<density::ColorCubeOctree> density;  // with a density style
   std::vector<MarkerLabel> labels;  // and their names
   // Changed since the last merge_into(), each surface (isosurfaces, slices, then the markers);
   // a change of the volume's visibility changes all of them.
@@ -172,6 +173,13 @@ VolumeLayer::VolumeLayer(const std::vector<VolumeSpec>& specs, const io::Mosaic&
     v->range = finite_range(v->data);
     for (const auto& s : spec.isosurfaces) v->isosurfaces.push_back(v->iso_mesh(s));
     for (const auto& s : spec.slices) v->slices.push_back(v->slice_mesh(s));
+    if (spec.density) {
+      try {
+        v->density = std::make_unique<density::ColorCubeOctree>(v->data, frame, v->ground_function(), *spec.density);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(spec.file.string() + ": " + e.what());
+      }
+    }
     v->markers = marker_mesh(transmitters_of(v->data), frame, v->ground);
     v->labels = marker_labels_of(transmitters_of(v->data), frame, v->ground);
     v->changed.assign(v->isosurfaces.size() + v->slices.size() + 1, true);
@@ -295,10 +303,47 @@ std::string slice_text(const volume::SliceSpec& s) {
 
 }  // namespace
 
+bool VolumeLayer::density_boxes(const mrbsp::Camera& camera, const density::RefineOptions& options,
+                                std::vector<mrbsp::ColorBox>& out, density::RefineStats& stats) const {
+  for (const auto& v : volumes_) {
+    if (!v->spec.visible || !v->density) continue;
+    v->density->refine(camera, options, out, stats);
+    return true;
+  }
+  stats = {};
+  return false;
+}
+
+void VolumeLayer::set_density(std::size_t volume, const density::DensitySpec& d) {
+  spec(volume);
+  Loaded& v = *volumes_[volume];
+  if (!v.density) throw std::invalid_argument("volume " + std::to_string(volume + 1) + " has no density");
+  volume::colormap_by_name(d.colormap);  // throws for an unknown map, before anything changes
+  v.density->set_transfer(d);
+  v.spec.density = d;
+}
+
+DensityFigures VolumeLayer::density_figures() const {
+  DensityFigures f;
+  for (std::size_t k = 0; k < volumes_.size(); ++k) {
+    const Loaded& v = *volumes_[k];
+    if (!v.spec.visible || !v.density) continue;
+    f.drawn = true;
+    f.volume = k;
+    f.grid = v.density->grid();
+    f.levels = v.density->levels();
+    f.bytes = v.density->bytes();
+    f.resample_ms = v.density->resample_ms();
+    f.build_ms = v.density->build_ms();
+    break;
+  }
+  return f;
+}
+
 Legend VolumeLayer::legend() const {
   Legend legend;
   for (const auto& v : volumes_) {
-    if (!v->spec.visible || (v->spec.slices.empty() && v->spec.isosurfaces.empty())) continue;
+    if (!v->spec.visible || (v->spec.slices.empty() && v->spec.isosurfaces.empty() && !v->spec.density)) continue;
     const std::string units = v->data.units.empty() ? "" : " (" + v->data.units + ")";
     legend.title = v->data.name + units;
     if (!v->spec.slices.empty() && volume::is_categorical(v->spec.slices.front().colormap)) {
@@ -322,6 +367,15 @@ Legend VolumeLayer::legend() const {
       legend.hi = s.hi.value_or(v->range[1]);
       legend.colormap = std::string(volume::colormap_by_name(s.colormap).name());
       legend.subtitle = slice_text(s) + ": " + legend.colormap;
+    } else if (v->spec.density) {
+      const density::DensitySpec& d = *v->spec.density;
+      legend.lo = d.lo;
+      legend.hi = d.hi;
+      legend.colormap = d.colormap;
+      char b[96];
+      std::snprintf(b, sizeof b, "density, %g per km (%s): %s", d.sigma_per_km, std::string(density::ramp_name(d.ramp)).c_str(),
+                    d.colormap.c_str());
+      legend.subtitle = b;
     }
     break;
   }

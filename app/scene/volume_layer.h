@@ -5,6 +5,7 @@
 // next merge_into() re-merges that surface alone (TerrainTree::set_surfaces).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -15,6 +16,7 @@
 #include "app/scene/scene_file.h"
 #include "app/scene/terrain_colors.h"
 #include "app/scene/terrain_scene.h"
+#include "density/octree.h"
 #include "io/mosaic.h"
 #include "io/scene_frame.h"
 #include "volume/geometry.h"
@@ -55,7 +57,17 @@ struct Legend {
   bool empty() const { return colormap.empty() && levels.empty() && categories.empty(); }
 };
 
-// A volume's value at a point (VolumeLayer::values_at).
+// The density drawn (VolumeLayer::density_boxes): its octree and what building it cost.
+struct DensityFigures {
+  bool drawn = false;      // a visible volume has a density style
+  std::size_t volume = 0;  // which
+  density::BoxGrid grid;   // its leaves (scene frame)
+  int levels = 0;
+  std::size_t bytes = 0;
+  double resample_ms = 0;  // the columns, when read
+  double build_ms = 0;     // the faces, after the last transfer function (set_density)
+};
+
 // A transmitter marker's label: the transmitter's name ("tx" for an unnamed one), anchored
 // 20 m above the top of its marker (scene frame, metres).
 struct MarkerLabel {
@@ -122,6 +134,21 @@ class VolumeLayer {
   // numbers in the volume's range. Empty when there is none. Throws std::invalid_argument for
   // a malformed "transmitters" attribute.
   Legend legend() const;
+
+  // Densities (issue 15): each volume with a density style gets a colour-cube octree
+  // (density::ColorCubeOctree, built when the volume is read, in the scene frame, over the
+  // ground under it). One density is drawn: the first visible volume's that has one (two
+  // densities would overlap, and their cells' orders could not be merged). Appends its cells
+  // refined for `camera` to `out`, in back-to-front order; false (nothing appended) when no
+  // visible volume has a density.
+  bool density_boxes(const mrbsp::Camera& camera, const density::RefineOptions& options, std::vector<mrbsp::ColorBox>& out,
+                     density::RefineStats& stats) const;
+  // A new transfer function for a volume's density (every cell's faces built again; the next
+  // frame draws them). Throws std::invalid_argument for an index out of range, a volume
+  // without a density, or a colour map that does not exist.
+  void set_density(std::size_t volume, const density::DensitySpec& spec);
+  // The density density_boxes() draws now, and its cost.
+  DensityFigures density_figures() const;
 
   // Each visible volume's value at (lat, lon) and height_agl metres above the ground there,
   // ground_m metres above the datum (volume::PointQuery: trilinear, NaN outside), in order.

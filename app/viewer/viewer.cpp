@@ -59,6 +59,7 @@
 #include "app/scene/timing.h"
 #include "app/scene/volume_layer.h"
 #include "app/viewer/overlay_layout.h"
+#include "density/transfer.h"
 #include "io/mosaic.h"
 
 namespace terravol::app::viewer {
@@ -81,6 +82,8 @@ const char* const kViewKeys =
     "X            transmitter markers on / off\n"
     "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
     ", / .        lower / raise its first isosurface's level by 2 units\n"
+    "E / Shift+E  density: finer / coarser colour cubes (epsilon / or x sqrt 2)\n"
+    "O / Shift+O  density: the selected volume's opacity x sqrt 2 / or / sqrt 2 (cubes built again)\n"
     "P            screenshot (PNG)\n"
     "K / J        record a keyframe of the camera / save the keyframes as a camera path\n"
     "Home         back to the starting pose\n"
@@ -248,6 +251,7 @@ class Viewer {
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void volume_key(const std::string& key);
   void markers_key();
+  void density_key(const std::string& key);
   void write_profile(const io::Geodetic& from, const io::Geodetic& to);
   void record_key();
   void save_path();
@@ -533,6 +537,8 @@ void Viewer::key_press(const std::string& key) {
     pipeline_->set_auto_slide(!pipeline_->auto_slide());
   } else if (key == "x") {
     markers_key();
+  } else if (key == "e" || key == "E" || key == "o" || key == "O") {
+    density_key(key);
   } else if (key == "p") {
     screenshot_pending_ = true;
   } else if (key == "k") {
@@ -678,6 +684,34 @@ void Viewer::markers_key() {
   char b[128];
   std::snprintf(b, sizeof b, "transmitter markers %s: %.0f ms (%zu surfaces merged)", volumes.markers_shown() ? "on" : "off",
                 last_merge_ms_, merge.merged_surfaces);
+  message_ = b;
+}
+
+// E, Shift+E: epsilon of the colour cubes (the next frame refines with it); O, Shift+O: the
+// selected volume's density opacity, a new transfer function (its cubes built again).
+void Viewer::density_key(const std::string& key) {
+  scene::VolumeLayer& volumes = pipeline_->volumes();
+  char b[160];
+  if (key == "e" || key == "E") {
+    density::RefineOptions d = pipeline_->density_options();
+    d.threshold_px = std::clamp(key == "e" ? d.threshold_px / std::sqrt(2.0) : d.threshold_px * std::sqrt(2.0),
+                                scene::kMinDensityThreshold, scene::kMaxDensityThreshold);
+    pipeline_->set_density_options(d);
+    std::snprintf(b, sizeof b, "density threshold %.2f px", d.threshold_px);
+    message_ = b;
+    return;
+  }
+  if (selected_volume_ >= volumes.size() || !volumes.spec(selected_volume_).density) {
+    message_ = "volume " + std::to_string(selected_volume_ + 1) + " has no density (give --density)";
+    return;
+  }
+  density::DensitySpec d = *volumes.spec(selected_volume_).density;
+  d.sigma_per_km *= key == "o" ? std::sqrt(2.0) : 1.0 / std::sqrt(2.0);
+  const auto t0 = Clock::now();
+  volumes.set_density(selected_volume_, d);
+  if (o_.style.legend) pipeline_->renderer().set_legend(volumes.legend());
+  last_merge_ms_ = ms_since(t0);
+  std::snprintf(b, sizeof b, "density opacity %.3g per km: cubes built in %.0f ms", d.sigma_per_km, last_merge_ms_);
   message_ = b;
 }
 
@@ -1097,8 +1131,10 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
     for (const auto& iso : spec.isosurfaces) jv["isovalues"].push_back(iso.value);
     jv["slices"] = ordered_json::array();
     for (const auto& s : spec.slices) jv["slices"].push_back({{"kind", volume::slice_kind_name(s.kind)}, {"value", s.value}});
+    if (spec.density) jv["density"] = density::format_density(*spec.density);
     j["volumes"].push_back(jv);
   }
+  j["density_threshold"] = pipeline_->density_options().threshold_px;
   const scene::MergeFigures& merge = pipeline_->merge_figures();
   j["merged_triangles"] = merge.tree_triangles;
   j["merge"] = {{"input_triangles", merge.input_triangles},
