@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "app/scene/timing.h"
@@ -175,11 +176,27 @@ double TerrainScene::ground_height(double lat, double lon) const {
 }
 
 double TerrainScene::far_plane(const glm::dvec3& eye) const {
+  glm::dvec3 lo(xs_.front(), ys_.front(), min_z_), hi(xs_.back(), ys_.back(), max_z_);
+  const std::vector<glm::vec3>& positions = tree_.positions();
+  const std::size_t base = tree_.merged_base();
+  if (merged_box_.version != tree_.merged_version() || merged_box_.count != positions.size()) {
+    merged_box_.version = tree_.merged_version();
+    merged_box_.count = positions.size();
+    merged_box_.lo = glm::dvec3(std::numeric_limits<double>::max());
+    merged_box_.hi = glm::dvec3(std::numeric_limits<double>::lowest());
+    for (std::size_t v = base; v < positions.size(); ++v) {
+      merged_box_.lo = glm::min(merged_box_.lo, glm::dvec3(positions[v]));
+      merged_box_.hi = glm::max(merged_box_.hi, glm::dvec3(positions[v]));
+    }
+  }
+  if (positions.size() > base) {
+    lo = glm::min(lo, merged_box_.lo);
+    hi = glm::max(hi, merged_box_.hi);
+  }
   double far = 0.0;
-  for (double x : {xs_.front(), xs_.back()})
-    for (double y : {ys_.front(), ys_.back()})
-      for (double z : {static_cast<double>(min_z_), static_cast<double>(max_z_)})
-        far = std::max(far, glm::length(glm::dvec3(x, y, z) - eye));
+  for (double x : {lo.x, hi.x})
+    for (double y : {lo.y, hi.y})
+      for (double z : {lo.z, hi.z}) far = std::max(far, glm::length(glm::dvec3(x, y, z) - eye));
   return far * 1.05 + 100.0;
 }
 

@@ -2,6 +2,8 @@
 // voids filled, placed in a scene frame about the window's centre, and its MRBSP tree.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -113,8 +115,9 @@ class TerrainScene {
   // clamped to its edge.
   double ground_height(double lat, double lon) const;
 
-  // A far clipping distance for an eye (scene frame): the farthest any window sample can be,
-  // plus 5% and 100 m.
+  // A far clipping distance for an eye (scene frame): the farthest any window sample or merged
+  // vertex (volumes, objects and paths may reach beyond the window and above its highest
+  // sample) can be, plus 5% and 100 m.
   double far_plane(const glm::dvec3& eye) const;
 
  private:
@@ -130,6 +133,14 @@ class TerrainScene {
   float min_z_ = 0, max_z_ = 0;
   double build_ms_ = 0;
   mrbsp::TerrainTree tree_;
+  // The merged vertices' box, for far_plane(): recomputed when the tree's merged_version() or
+  // vertex count changed.
+  struct MergedBox {
+    std::uint64_t version = ~std::uint64_t{0};
+    std::size_t count = 0;
+    glm::dvec3 lo{0.0}, hi{0.0};
+  };
+  mutable MergedBox merged_box_;
 };
 
 }  // namespace terravol::app::scene
