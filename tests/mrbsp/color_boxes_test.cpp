@@ -13,38 +13,10 @@
 namespace terravol::mrbsp {
 namespace {
 
+using test::frame_vertex;
+using test::hilly_tree;
+using test::order_violations;
 using test::TestWindow;
-
-// Vertex k of a frame: the tree's, or one of the frame's own for box faces.
-glm::dvec3 vertex(const TerrainTree& tree, const Frame& f, std::uint32_t k) {
-  if (k >= f.transient_base) return glm::dvec3(f.transient_positions[k - f.transient_base]);
-  return glm::dvec3(tree.positions()[k]);
-}
-
-// Along random rays from the eye, every pair of hits is drawn farthest first (or nearest first):
-// terrain, merged pieces and box faces alike.
-int violations(const TerrainTree& tree, const Frame& f, const glm::dvec3& eye, int rays, std::mt19937& rng,
-               bool back_to_front) {
-  std::normal_distribution<double> g;
-  int bad = 0;
-  std::vector<std::pair<double, std::size_t>> hits;
-  for (int r = 0; r < rays; ++r) {
-    const glm::dvec3 d = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
-    hits.clear();
-    for (std::size_t t = 0; t < f.level.size(); ++t) {
-      const double dist = test::ray_triangle(eye, d, vertex(tree, f, f.indices[3 * t]), vertex(tree, f, f.indices[3 * t + 1]),
-                                             vertex(tree, f, f.indices[3 * t + 2]));
-      if (dist > 0) hits.emplace_back(dist, t);
-    }
-    std::sort(hits.begin(), hits.end());
-    for (std::size_t a = 0; a < hits.size(); ++a)
-      for (std::size_t b = a + 1; b < hits.size(); ++b) {
-        if (hits[b].first - hits[a].first < 1e-6 * hits[b].first) continue;
-        if (back_to_front ? hits[a].second < hits[b].second : hits[a].second > hits[b].second) ++bad;
-      }
-  }
-  return bad;
-}
 
 // A grid of nx x ny x nz boxes over [x0, x1] x [y0, y1] x [z0, z1], in a back-to-front order
 // for `eye`: farther on z first, then on y, then on x (index distances from the eye's cell);
@@ -80,13 +52,6 @@ std::vector<ColorBox> grid_boxes(const glm::dvec3& eye, int nx, int ny, int nz, 
   std::vector<ColorBox> out;
   for (const Keyed& k : all) out.push_back(k.box);
   return out;
-}
-
-TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
-  std::uniform_real_distribution<float> h(0.0f, 40.0f);
-  for (std::size_t k = 0; k < w.z.size(); ++k)
-    w.z[k] = 200.0f + 150.0f * std::sin(0.4f * static_cast<float>(k % 17)) * std::cos(0.3f * static_cast<float>(k / 17)) + h(rng);
-  return TerrainTree(w.view(), 4);
 }
 
 // Translucent triangles through the terrain's volume, some of them crossing the boxes.
@@ -132,8 +97,8 @@ double drawn_box_area(const TerrainTree& tree, const Frame& f) {
   double area = 0.0;
   for (std::size_t t = 0; t < f.level.size(); ++t) {
     if (f.level[t] != kBoxLevel) continue;
-    area += test::polygon_area({vertex(tree, f, f.indices[3 * t]), vertex(tree, f, f.indices[3 * t + 1]),
-                                vertex(tree, f, f.indices[3 * t + 2])});
+    area += test::polygon_area({frame_vertex(tree, f, f.indices[3 * t]), frame_vertex(tree, f, f.indices[3 * t + 1]),
+                                frame_vertex(tree, f, f.indices[3 * t + 2])});
   }
   return area;
 }
@@ -215,7 +180,7 @@ TEST(ColorBoxes, FacesAreInBackToFrontOrderWithTerrainAndMergedPiecesFromRandomE
     tree.traverse(c, o, f, boxes);
     faces += f.boxes.faces;
     bsp_faces += f.boxes.bsp_faces;
-    EXPECT_EQ(violations(tree, f, eye, 150, rng, !o.front_to_back), 0) << "trial " << trial;
+    EXPECT_EQ(order_violations(tree, f, eye, 150, rng, !o.front_to_back), 0) << "trial " << trial;
   }
   EXPECT_GT(faces, 0u);
   EXPECT_GT(bsp_faces, 0u) << "some faces went into merged surfaces' small BSPs";
@@ -276,8 +241,8 @@ TEST(ColorBoxes, WithCullingTheDrawnFaceAreaInsideTheFrustumIsTheFaceAreaAboveTh
     double drawn = 0.0;
     for (std::size_t t = 0; t < f.level.size(); ++t) {
       if (f.level[t] != kBoxLevel) continue;
-      drawn += test::polygon_area(test::clip_all({vertex(tree, f, f.indices[3 * t]), vertex(tree, f, f.indices[3 * t + 1]),
-                                                  vertex(tree, f, f.indices[3 * t + 2])},
+      drawn += test::polygon_area(test::clip_all({frame_vertex(tree, f, f.indices[3 * t]), frame_vertex(tree, f, f.indices[3 * t + 1]),
+                                                  frame_vertex(tree, f, f.indices[3 * t + 2])},
                                                  frustum));
     }
     EXPECT_NEAR(drawn, expected, 1e-6 * expected + 1e-3) << "trial " << trial;

@@ -12,6 +12,7 @@ namespace {
 
 using test::drawn_merged_area;
 using test::order_violations;
+using test::hilly_tree;
 using test::TestWindow;
 
 // Random triangles through the terrain's volume (big and small), plus two lying exactly in
@@ -56,13 +57,6 @@ Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
     s.add({300.0, 400.0, 20.0}, {1200.0, 400.0, 30.0}, {700.0, 400.0, 380.0});  // in a y plane
   }
   return s;
-}
-
-TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
-  std::uniform_real_distribution<float> h(0.0f, 40.0f);
-  for (std::size_t k = 0; k < w.z.size(); ++k)
-    w.z[k] = 200.0f + 150.0f * std::sin(0.4f * static_cast<float>(k % 17)) * std::cos(0.3f * static_cast<float>(k / 17)) + h(rng);
-  return TerrainTree(w.view(), 4);
 }
 
 // A camera at `eye` looking along `forward` (not vertical), 60 degrees wide.

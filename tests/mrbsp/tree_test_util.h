@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -73,12 +74,18 @@ inline double ray_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::
   return glm::dot(e2, q) / det;
 }
 
+// Vertex k of a frame: the tree's, or one of the frame's own (colour boxes' faces).
+inline glm::dvec3 frame_vertex(const TerrainTree& tree, const Frame& f, std::uint32_t k) {
+  if (k >= f.transient_base) return glm::dvec3(f.transient_positions[k - f.transient_base]);
+  return glm::dvec3(tree.positions()[k]);
+}
+
 // For rays from the eye in many directions: along each ray, hits must be drawn from the
 // farthest to the nearest (back-to-front) or the reverse. Hits at the same distance (shared
 // edges, coplanar crack fills) are not ordered against each other. Returns the violations.
 inline int order_violations(const TerrainTree& tree, const Frame& f, const glm::dvec3& eye, int rays, std::mt19937& rng,
                      bool back_to_front) {
-  const auto& p = tree.positions();
+  const auto p = [&](std::uint32_t k) { return frame_vertex(tree, f, k); };
   std::normal_distribution<double> g;
   int violations = 0;
   std::vector<std::pair<double, std::size_t>> hits;
@@ -87,7 +94,7 @@ inline int order_violations(const TerrainTree& tree, const Frame& f, const glm::
     d = glm::normalize(d);
     hits.clear();
     for (std::size_t t = 0; t < f.indices.size() / 3; ++t) {
-      const double dist = ray_triangle(eye, d, p[f.indices[3 * t]], p[f.indices[3 * t + 1]], p[f.indices[3 * t + 2]]);
+      const double dist = ray_triangle(eye, d, p(f.indices[3 * t]), p(f.indices[3 * t + 1]), p(f.indices[3 * t + 2]));
       if (dist > 0) hits.emplace_back(dist, t);
     }
     std::sort(hits.begin(), hits.end());
@@ -99,6 +106,14 @@ inline int order_violations(const TerrainTree& tree, const Frame& f, const glm::
       }
   }
   return violations;
+}
+
+// A 4-level tree over `w` with rolling hills (50-390 m) and random noise.
+inline TerrainTree hilly_tree(std::mt19937& rng, TestWindow& w) {
+  std::uniform_real_distribution<float> h(0.0f, 40.0f);
+  for (std::size_t k = 0; k < w.z.size(); ++k)
+    w.z[k] = 200.0f + 150.0f * std::sin(0.4f * static_cast<float>(k % 17)) * std::cos(0.3f * static_cast<float>(k / 17)) + h(rng);
+  return TerrainTree(w.view(), 4);
 }
 
 }  // namespace terravol::mrbsp::test
