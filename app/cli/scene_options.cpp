@@ -168,16 +168,25 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
       throw std::invalid_argument("--volume-frame " + frame + ": " + e.what());
     }
   }
-  std::vector<volume::IsoSpec> iso_specs;
-  for (std::size_t k = 0; k < args.isos.size(); ++k) iso_specs.push_back(volume::parse_isosurface(args.isos[k], k));
+  // Each volume's --iso levels: those without a colour take the palette's by their place among
+  // every volume's, as in a scene file (volume v's level k is the (v * levels + k)-th).
+  const auto iso_specs = [&](std::size_t volume_index) {
+    std::vector<volume::IsoSpec> specs;
+    for (std::size_t k = 0; k < args.isos.size(); ++k) {
+      specs.push_back(volume::parse_isosurface(args.isos[k], volume_index * args.isos.size() + k));
+    }
+    return specs;
+  };
+  const std::vector<volume::IsoSpec> checked = iso_specs(0);  // bad levels fail here, volumes or not
   std::vector<volume::SliceSpec> slice_specs;
   for (const auto& text : args.slices) slice_specs.push_back(volume::parse_slice(text));
   std::optional<density::DensitySpec> density;
   if (!args.density.empty()) density = density::parse_density(args.density);
   for (scene::ObjectSpec& o : parse_objects(args.objects)) scene.objects.push_back(std::move(o));
   if (args.volumes.empty()) {
-    for (scene::VolumeSpec& v : scene.volumes) {
-      if (!iso_specs.empty()) v.isosurfaces = iso_specs;
+    for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
+      scene::VolumeSpec& v = scene.volumes[k];
+      if (!checked.empty()) v.isosurfaces = iso_specs(k);
       if (!slice_specs.empty()) v.slices = slice_specs;
       if (density) v.density = density;
     }
@@ -188,7 +197,7 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
     v.file = f;
     v.field = args.field;
     v.frame = frame;
-    v.isosurfaces = iso_specs;
+    v.isosurfaces = iso_specs(scene.volumes.size());
     v.slices = slice_specs;
     v.density = density;
     scene.volumes.push_back(std::move(v));

@@ -78,7 +78,9 @@ scene::SceneStyle given_style(const SceneArgs& args);
 // --volume files: each --volume FILE (read as --field, placed by --volume-frame) gets the
 // --iso, --slice and --density styles; with no --volume, non-empty --iso or --slice lists, or
 // a --density, replace the styles of every volume of the file; each --object
-// (scene::parse_object) joins the file's objects. Throws std::invalid_argument for a bad file
+// (scene::parse_object) joins the file's objects. A level without a colour takes the palette's
+// colour of its place among every volume's (volume v's level k is the (v * levels + k)-th), so
+// that the same level of two volumes differs. Throws std::invalid_argument for a bad file
 // or bad --iso, --slice, --density, --object, --volume-frame or --size text.
 scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
 
