@@ -306,15 +306,30 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
                                      scene::near_plane_for(clearance));
   const auto sky = settings_.gradient ? scene::sky_gradient(pose.pitch_deg, fov_y_deg)
                                       : std::array<scene::Rgb, 2>{settings_.background, settings_.background};
+  // The density's cells of this view (none for the tiler, which does not draw densities); the
+  // far plane holds them as it holds the window and the merged surfaces (they may lie beyond).
+  auto t0 = Clock::now();
+  boxes_.clear();
+  if (!tiled_) volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+  double far = scene_->far_plane(camera_.eye);
+  if (!boxes_.empty()) {
+    double farthest = 0.0;
+    for (const mrbsp::ColorBox& b : boxes_) {
+      const glm::dvec3 d = glm::max(glm::abs(glm::dvec3(b.lo) - camera_.eye), glm::abs(glm::dvec3(b.hi) - camera_.eye));
+      farthest = std::max(farthest, glm::dot(d, d));
+    }
+    far = std::max(far, std::sqrt(farthest) * 1.05 + 100.0);
+  }
+  stats.density_ms = ms_since(t0);
   if (renderer_) {
-    renderer_->set_camera(camera_, scene_->far_plane(camera_.eye));
+    renderer_->set_camera(camera_, far);
     if (renderer_->settings().gradient) renderer_->set_background(sky[0], sky[1]);
   } else {
     sky_ = sky;
-    far_plane_ = scene_->far_plane(camera_.eye);
+    far_plane_ = far;
   }
 
-  auto t0 = Clock::now();
+  t0 = Clock::now();
   objects_.update(*scene_, camera_, traversal);
   stats.objects_ms = ms_since(t0);
   stats.objects_merged = objects_.figures().remerged;
@@ -323,21 +338,6 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
     const int aa = tiled_->settings().aa;
     scene_->tree().traverse(tiled_traversal_camera(camera_, traversal, aa), tiled_traversal(traversal, aa), frame_);
   } else {
-    boxes_.clear();
-    volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
-    if (!boxes_.empty()) {
-      // The far plane holds the density's cells too (they may lie beyond the window).
-      const double window_far = scene_->far_plane(camera_.eye);
-      double far = 0.0;
-      for (const mrbsp::ColorBox& b : boxes_) {
-        const glm::dvec3 d = glm::max(glm::abs(glm::dvec3(b.lo) - camera_.eye), glm::abs(glm::dvec3(b.hi) - camera_.eye));
-        far = std::max(far, glm::dot(d, d));
-      }
-      far = std::sqrt(far) * 1.05 + 100.0;
-      if (far > window_far) renderer_->set_camera(camera_, far);
-    }
-    stats.density_ms = ms_since(t0);
-    t0 = Clock::now();
     scene_->tree().traverse(camera_, traversal, frame_, boxes_);
   }
   stats.traversal_ms = ms_since(t0);
