@@ -211,21 +211,28 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   const mrbsp::TraversalOptions lod_default;
 
   std::map<std::string, std::vector<double>> ms, err3, psnr_db, ratio;
+  std::map<std::string, std::vector<double>> bsp_parts;  // the bsp frame: traversal, upload, draw
   std::vector<double> triangles, merged_triangles, plain_triangles;
   for (std::size_t v = 0; v < views.size(); ++v) {
     const app::scene::CameraPose& pose = views[v].pose;
     if (v == 0) scene.render(pose, true, 45.0, lod_default);  // warm-up
-    std::vector<double> t_bsp;
+    std::vector<double> t_bsp, t_traversal, t_upload, t_draw;
     app::render::FrameStats s;
     for (int r = 0; r < c.repeats; ++r) {
       s = scene.render(pose, true, 45.0, lod_default);
       t_bsp.push_back(frame_ms(s));
+      t_traversal.push_back(s.traversal_ms);
+      t_upload.push_back(s.upload_ms);
+      t_draw.push_back(s.draw_ms);
     }
     if (s.slides > 0) throw std::runtime_error("translucency " + terrain.name + ": the window slid; views must stay inside");
     triangles.push_back(static_cast<double>(s.triangles));
     merged_triangles.push_back(static_cast<double>(s.merged_triangles));
     const std::vector<std::uint8_t> bsp = scene.rgb();
     ms["bsp"].push_back(median(t_bsp));
+    bsp_parts["traversal"].push_back(median(t_traversal));
+    bsp_parts["upload"].push_back(median(t_upload));
+    bsp_parts["draw"].push_back(median(t_draw));
     const double far = far_plane(scene);
 
     std::map<std::string, std::vector<std::uint8_t>> images;
@@ -273,9 +280,12 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
     psnr_db["plain_peel4"].push_back(std::min(99.0, psnr(images["plain_peel4"], images["plain_peel_exact"], c.width, c.height)));
     for (const char* name : {"peel_exact", "peel4", "vtk_default", "plain_peel4", "plain_peel_exact"})
       ratio[name].push_back(ms[name].back() / ms["bsp"].back());
-    char b2[200];
-    std::snprintf(b2, sizeof b2, "translucency %s: view %zu/%zu  bsp %.0f ms, peel %.0f ms, plain peel4 %.0f ms",
-                  terrain.name.c_str(), v + 1, views.size(), ms["bsp"].back(), ms["peel_exact"].back(),
+    char b2[300];
+    std::snprintf(b2, sizeof b2,
+                  "translucency %s: view %zu/%zu  bsp %.0f ms (traversal %.0f, upload %.0f, draw %.0f), peel %.0f ms, "
+                  "plain peel4 %.0f ms",
+                  terrain.name.c_str(), v + 1, views.size(), ms["bsp"].back(), bsp_parts["traversal"].back(),
+                  bsp_parts["upload"].back(), bsp_parts["draw"].back(), ms["peel_exact"].back(),
                   ms["plain_peel4"].back());
     say(c, b2);
   }
@@ -295,6 +305,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   out["merged_triangles"] = to_json(summarize(merged_triangles));
   out["plain_triangles"] = to_json(summarize(plain_triangles));
   for (const auto& [name, v] : ms) out["frame_ms"][name] = to_json(summarize(v));
+  for (const auto& [name, v] : bsp_parts) out["bsp_frame_parts_ms"][name] = to_json(summarize(v));
   for (const auto& [name, v] : ratio) out["ratio_over_bsp"][name] = to_json(summarize(v));
   for (const auto& [name, v] : err3) out["share_over_3"][name] = to_json(summarize(v));
   for (const auto& [name, v] : psnr_db) out["psnr_db"][name] = to_json(summarize(v));
@@ -412,7 +423,7 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
       j["plain_frame_ms"] = to_json(summarize(p));
       j["plain_triangles"] = plain->triangles();
     }
-    char b2[200];
+    char b2[300];
     std::snprintf(b2, sizeof b2, "scaling %s: %zu samples, MRBSP %.1f ms, %zu triangles", t.name.c_str(),
                   (n + 1) * (n + 1), summarize(fr).median, s.triangles);
     say(c, b2);

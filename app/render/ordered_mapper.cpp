@@ -9,12 +9,18 @@
 #include <vtkOpenGLVertexBufferObjectGroup.h>
 #include <vtkPoints.h>
 #include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
+#include <vtkOpenGLVertexArrayObject.h>
 #include <vtkPointData.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
+#include <vtkShader.h>
+#include <vtkShaderProgram.h>
 #include <vtkTypeInt32Array.h>
 #include <vtk_glew.h>
+
+#include <string>
 
 namespace terravol::app::render {
 
@@ -54,6 +60,7 @@ void OrderedPolyDataMapper::BuildIBO(vtkRenderer* ren, vtkActor* act, vtkPolyDat
       poly->GetVerts()->GetNumberOfCells() == 0 && poly->GetLines()->GetNumberOfCells() == 0 &&
       poly->GetStrips()->GetNumberOfCells() == 0 && !polys->IsStorage64Bit() &&
       polys->IsHomogeneous() == 3;
+  direct_ = direct;
   if (!direct) {
     Superclass::BuildIBO(ren, act, poly);
     return;
@@ -109,6 +116,89 @@ void OrderedPolyDataMapper::BuildBufferObjects(vtkRenderer* ren, vtkActor* act) 
                     static_cast<const unsigned char*>(scalars->GetVoidPointer(0)) + 4 * first);
     colours->Release();
   }
+}
+
+bool OrderedPolyDataMapper::ready_plain(vtkRenderer* ren, vtkActor* act) {
+  vtkOpenGLHelper& tris = this->Primitives[PrimitiveTris];
+  vtkOpenGLShaderCache* cache = static_cast<vtkOpenGLRenderWindow*>(ren->GetRenderWindow())->GetShaderCache();
+  if (plain_.Program == nullptr || plain_source_ != tris.Program || tris.ShaderSourceTime > plain_.ShaderSourceTime) {
+    plain_.Program = nullptr;
+    plain_source_ = nullptr;
+    std::string fs = tris.Program->GetFragmentShader()->GetSource();
+    const std::size_t begin = fs.find(kTextureBegin);
+    const std::size_t end = fs.find(kTextureEnd);
+    if (begin == std::string::npos || end == std::string::npos || end < begin) return false;
+    fs.replace(begin, end + kTextureEnd.size() - begin, "gl_FragData[0] = vertexColorVSOutput;");
+    // VTK's sources as it compiled them: its replacements are done, so the cache's own pass
+    // changes nothing but the output's name in the line above.
+    vtkShaderProgram* plain = cache->ReadyShaderProgram(tris.Program->GetVertexShader()->GetSource().c_str(), fs.c_str(),
+                                                        tris.Program->GetGeometryShader()->GetSource().c_str());
+    if (plain == nullptr) return false;
+    plain_.Program = plain;
+    plain_source_ = tris.Program;
+    plain_.ShaderSourceTime.Modified();
+    plain_.VAO->ReleaseGraphicsResources();
+  } else if (cache->ReadyShaderProgram(plain_.Program) == nullptr) {
+    return false;
+  }
+  plain_.VAO->Bind();
+  if (this->VBOs->GetMTime() > plain_.AttributeUpdateTime || plain_.ShaderSourceTime > plain_.AttributeUpdateTime) {
+    this->VBOs->AddAllAttributesToVAO(plain_.Program, plain_.VAO);
+    plain_.AttributeUpdateTime.Modified();
+  }
+  // The uniforms VTK's program gets for an unlit, untextured surface (UpdateShaders).
+  this->SetCustomUniforms(plain_, act);
+  this->SetPropertyShaderParameters(plain_, ren, act);
+  this->SetCameraShaderParameters(plain_, ren, act);
+  return true;
+}
+
+void OrderedPolyDataMapper::RenderPieceDraw(vtkRenderer* ren, vtkActor* act) {
+  vtkOpenGLHelper& tris = this->Primitives[PrimitiveTris];
+  const std::size_t triangles = tris.IBO->IndexCount / 3;
+  const bool split = direct_ && !untextured_.empty() && ren->GetSelector() == nullptr &&
+                     untextured_.back().first + untextured_.back().count <= triangles;
+  if (!split) {
+    Superclass::RenderPieceDraw(ren, act);
+    return;
+  }
+  // VTK's program, bound with its uniforms and VAO; then the untextured one, if the shader has
+  // the block to replace.
+  this->UpdateShaders(tris, ren, act);
+  vtkOpenGLShaderCache* cache = static_cast<vtkOpenGLRenderWindow*>(ren->GetRenderWindow())->GetShaderCache();
+  if (!ready_plain(ren, act)) {
+    cache->ReadyShaderProgram(tris.Program);
+    tris.VAO->Bind();
+    Superclass::RenderPieceDraw(ren, act);
+    return;
+  }
+  const auto last = static_cast<GLuint>(this->VBOs->GetNumberOfTuples("vertexMC") - 1);
+  auto draw = [&](vtkOpenGLHelper& with, std::size_t first, std::size_t count) {
+    if (count == 0) return;
+    cache->ReadyShaderProgram(with.Program);
+    with.VAO->Bind();
+    tris.IBO->Bind();
+    glDrawRangeElements(GL_TRIANGLES, 0, last, static_cast<GLsizei>(3 * count), GL_UNSIGNED_INT,
+                        reinterpret_cast<const GLvoid*>(3 * first * sizeof(GLuint)));
+  };
+  std::size_t next = 0;
+  for (const Run& run : untextured_) {
+    draw(tris, next, run.first - next);
+    draw(plain_, run.first, run.count);
+    next = run.first + run.count;
+  }
+  draw(tris, next, triangles - next);
+  // As VTK leaves it: its program and VAO bound (RenderPieceFinish releases that VAO).
+  tris.IBO->Release();
+  cache->ReadyShaderProgram(tris.Program);
+  tris.VAO->Bind();
+}
+
+void OrderedPolyDataMapper::ReleaseGraphicsResources(vtkWindow* win) {
+  plain_.ReleaseGraphicsResources(win);
+  plain_.Program = nullptr;
+  plain_source_ = nullptr;
+  Superclass::ReleaseGraphicsResources(win);
 }
 
 void OrderedPolyDataMapper::RenderPieceFinish(vtkRenderer* ren, vtkActor* act) {

@@ -4,12 +4,18 @@
 #pragma once
 
 #include <vtkNew.h>
+#include <vtkOpenGLHelper.h>
 #include <vtkOpenGLPolyDataMapper.h>
 #include <vtkPolyData.h>
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <string_view>
+#include <utility>
 #include <vector>
+
+class vtkShaderProgram;
 
 namespace terravol::app::render {
 
@@ -35,6 +41,7 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
 
   void RenderPieceStart(vtkRenderer* ren, vtkActor* act) override;
   void RenderPieceFinish(vtkRenderer* ren, vtkActor* act) override;
+  void ReleaseGraphicsResources(vtkWindow* win) override;
 
   // Blending on (the default) or off while drawing; see above.
   void set_blending(bool on) { blending_ = on; }
@@ -51,6 +58,26 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
     update_count_ = count;
   }
 
+  // Runs of triangles (in the cell array's order, counted in triangles) that need no texture:
+  // merged pieces, whose colour is their vertices' whatever the texture says. llvmpipe runs
+  // both sides of a fragment shader's branch on every fragment (it masks, it does not jump),
+  // so in one draw every merged fragment pays the terrain's bilinear texture fetch: about 35
+  // ms of a 1280x720 frame of the benchmark's volumes over N44W072. These runs are drawn with a
+  // second program instead: VTK's own, built from the same sources with the fragment shader's
+  // text between kTextureBegin and kTextureEnd replaced by the vertex colour. The other
+  // triangles, and everything when the shader has no such block, take VTK's program. The
+  // image is the same: the replaced block gives a merged vertex's colour anyway (its texture
+  // coordinates are negative). Each run costs two draw calls and a program switch, so only
+  // long runs pay (TerrainRenderer keeps runs of at least kMinUntexturedRun).
+  struct Run {
+    std::uint32_t first = 0, count = 0;
+  };
+  static constexpr std::string_view kTextureBegin = "//TERRAVOL::Texture::Begin";
+  static constexpr std::string_view kTextureEnd = "//TERRAVOL::Texture::End";
+  static constexpr std::uint32_t kMinUntexturedRun = 128;
+  // Sorted, disjoint, within the triangles of the next draw.
+  void set_untextured_runs(std::vector<Run> runs) { untextured_ = std::move(runs); }
+
   OrderedPolyDataMapper(const OrderedPolyDataMapper&) = delete;
   OrderedPolyDataMapper& operator=(const OrderedPolyDataMapper&) = delete;
 
@@ -59,6 +86,7 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   ~OrderedPolyDataMapper() override = default;
   void BuildIBO(vtkRenderer* ren, vtkActor* act, vtkPolyData* poly) override;
   void BuildBufferObjects(vtkRenderer* ren, vtkActor* act) override;
+  void RenderPieceDraw(vtkRenderer* ren, vtkActor* act) override;
 
  private:
   bool blending_ = true;
@@ -68,6 +96,13 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   bool saved_blend_ = false;
   std::array<int, 4> saved_blend_func_{};
   vtkNew<vtkPolyData> no_triangles_;  // the input without its triangles, for VTK's other buffers
+  bool direct_ = false;                // the last BuildIBO uploaded the triangles as they are
+
+  // The untextured program (see set_untextured_runs), its VAO, and the VTK program it was made from.
+  std::vector<Run> untextured_;
+  vtkOpenGLHelper plain_;
+  vtkShaderProgram* plain_source_ = nullptr;
+  bool ready_plain(vtkRenderer* ren, vtkActor* act);
 };
 
 }  // namespace terravol::app::render

@@ -375,6 +375,22 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   }
   const auto triangles = static_cast<vtkIdType>(terrain->size() / 3);
   poly_->SetPolys(triangle_cells(*terrain));
+  if (auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_)) {
+    // Long runs of merged pieces and box faces: drawn without the texture's fetch.
+    std::vector<OrderedPolyDataMapper::Run> runs;
+    if (actor_->GetTexture() != nullptr) {
+      const std::size_t n = std::min(levels->size(), static_cast<std::size_t>(triangles));
+      for (std::size_t t = 0; t < n;) {
+        std::size_t e = t;
+        while (e < n && ((*levels)[e] == mrbsp::kMergedLevel || (*levels)[e] == mrbsp::kBoxLevel)) ++e;
+        if (e - t >= OrderedPolyDataMapper::kMinUntexturedRun) {
+          runs.push_back({static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(e - t)});
+        }
+        t = e == t ? t + 1 : e;
+      }
+    }
+    ordered->set_untextured_runs(std::move(runs));
+  }
 
   vtkNew<vtkSignedCharArray> level;
   level->SetName("level");
@@ -421,8 +437,11 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
 void TerrainRenderer::install_shaders(vtkActor& actor, bool textured) {
   vtkShaderProperty* shader = actor.GetShaderProperty();
   shader->ClearAllShaderReplacements();
-  std::string colour = textured ? "  if (tcoordVCVSOutput.s < 0.0) { gl_FragData[0] = vertexColorVSOutput; }\n"
-                                  "  else { gl_FragData[0] = texture(actortexture, tcoordVCVSOutput.st); }\n"
+  // The texture's block between the ordered mapper's markers: its untextured runs replace it.
+  std::string colour = textured ? std::string(OrderedPolyDataMapper::kTextureBegin) +
+                                      "\n  if (tcoordVCVSOutput.s < 0.0) { gl_FragData[0] = vertexColorVSOutput; }\n"
+                                      "  else { gl_FragData[0] = texture(actortexture, tcoordVCVSOutput.st); }\n" +
+                                      std::string(OrderedPolyDataMapper::kTextureEnd) + "\n"
                                 : "//VTK::TCoord::Impl\n";
   if (settings_.haze_distance > 0.0) {
     // The haze of each vertex from its depth along the view axis (clip-space w), interpolated,

@@ -5,7 +5,9 @@
 
 #include <vector>
 
+#include "app/render/ordered_mapper.h"
 #include "app/render/terrain_renderer.h"
+#include "mrbsp/terrain_tree.h"
 #include "image_compare.h"
 #include "require_display.h"
 
@@ -133,6 +135,75 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
     renderer.render();
     EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32), (test::Rgb8{255, 255, 255}));
   }
+}
+
+// A textured floor (8 x 8 at z = 0, one yellow texel) and, over its left half, a run of 128
+// thin half-transparent blue triangles (merged pieces: vertex colours, texture coordinates -1)
+// at z = 1; then a textured square at z = 2 over the bottom-left quadrant. Drawn in that order,
+// seen from 20 above (the floor spans about 48 of the 64 pixels).
+struct TexturedRun {
+  std::vector<glm::vec3> positions;
+  scene::TerrainShading shading;
+  std::vector<std::uint32_t> indices;
+  std::vector<std::int8_t> level;
+};
+
+TexturedRun textured_run(std::int8_t run_level) {
+  TexturedRun s;
+  auto vertex = [&](float x, float y, float z, scene::Rgba c, glm::vec2 t) {
+    s.positions.emplace_back(x, y, z);
+    s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
+    s.shading.shade.push_back(1.0f);
+    s.shading.rgba.push_back(c);
+    s.shading.tcoords.push_back(t);
+    return static_cast<std::uint32_t>(s.positions.size() - 1);
+  };
+  auto quad = [&](float x0, float y0, float x1, float y1, float z, scene::Rgba c, bool textured, std::int8_t lv) {
+    const glm::vec2 t0 = textured ? glm::vec2(0.5f) : glm::vec2(-1.0f);
+    const std::uint32_t a = vertex(x0, y0, z, c, t0), b = vertex(x1, y0, z, c, t0), d = vertex(x1, y1, z, c, t0),
+                        e = vertex(x0, y1, z, c, t0);
+    s.indices.insert(s.indices.end(), {a, b, d, a, d, e});
+    s.level.insert(s.level.end(), {lv, lv});
+  };
+  const scene::Rgba grey{90, 90, 90, 255};  // the vertex colour the texture replaces
+  quad(-4.0f, -4.0f, 4.0f, 4.0f, 0.0f, grey, true, 0);
+  for (int k = 0; k < 64; ++k) {  // 128 triangles: the ordered mapper's shortest untextured run
+    const float y0 = -4.0f + 8.0f * k / 64.0f;
+    quad(-4.0f, y0, 0.0f, y0 + 8.0f / 64.0f, 1.0f, scene::Rgba{0, 0, 255, 128}, false, run_level);
+  }
+  quad(-4.0f, -4.0f, 0.0f, 0.0f, 2.0f, grey, true, 0);
+  return s;
+}
+
+test::Image textured_run_image(std::int8_t run_level) {
+  const TexturedRun s = textured_run(run_level);
+  const std::vector<scene::Rgba> texel{{255, 255, 0, 255}};
+  TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp), {1, texel});
+  renderer.set_camera(two_squares(255).camera, 100.0);
+  mrbsp::Frame f;
+  f.indices = s.indices;
+  f.level = s.level;
+  renderer.set_frame(f);
+  renderer.render();
+  return test::image_of_rgb(renderer.rgb(), 64, 64);
+}
+
+TEST(TerrainRenderer, LongRunsOfMergedPiecesDrawnWithoutTheTextureGiveTheSameImageInOrder) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  static_assert(OrderedPolyDataMapper::kMinUntexturedRun <= 128);
+  // Merged pieces: the run takes the untextured program. Terrain level 0: one draw, VTK's.
+  const test::Image split = textured_run_image(mrbsp::kMergedLevel);
+  const test::Image single = textured_run_image(0);
+  ASSERT_EQ(split.width, 64);
+  ASSERT_EQ(single.width, 64);
+  EXPECT_EQ(split.pixels, single.pixels);
+  // Row 0 is the top of the picture (north, +y).
+  EXPECT_EQ(split.at(48, 32), (test::Rgb8{255, 255, 0})) << "the floor's texture, right";
+  EXPECT_EQ(split.at(24, 48), (test::Rgb8{255, 255, 0})) << "the square drawn after the run, bottom left";
+  const test::Rgb8 blended = split.at(24, 8);  // the run over the floor, top left
+  EXPECT_NEAR(blended[0], 127, 2);
+  EXPECT_NEAR(blended[1], 127, 2);
+  EXPECT_NEAR(blended[2], 128, 2);
 }
 
 }  // namespace
