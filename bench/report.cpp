@@ -141,7 +141,13 @@ void translucency_section(std::ostringstream& md, const json& results) {
        << num(m["merge_ms"].get<double>(), "%.0f") << " ms, " << num(m["merged_bytes"].get<double>() / 1048576.0, "%.0f")
        << " MiB. Triangles per frame: " << num(med(t["triangles"]), "%.0f") << " (of them merged "
        << num(med(t["merged_triangles"]), "%.0f") << "); plain pipeline " << num(med(t["plain_triangles"]), "%.0f")
-       << ".\n\n"
+       << ".";
+    if (t.contains("bsp_frame_parts_ms")) {
+      const json& p = t["bsp_frame_parts_ms"];
+      md << " The bsp frame (medians over the views): traversal " << num(med(p["traversal"]), "%.1f") << " ms, upload "
+         << num(med(p["upload"]), "%.1f") << " ms, draw " << num(med(p["draw"]), "%.1f") << " ms.";
+    }
+    md << "\n\n"
        << "| drawing | frame ms | this / bsp | pixels > 3/255 from exact | PSNR dB |\n|---|---|---|---|---|\n";
     for (const char* name : {"bsp", "peel_exact", "peel4", "vtk_default", "plain_peel4", "plain_peel_exact"}) {
       md << "| " << name << " | " << spread(t["frame_ms"][name]) << " | "
