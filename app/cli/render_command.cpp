@@ -60,6 +60,7 @@ struct RenderOptions {
   std::vector<scene::ObjectSpec> objects;  // models placed on the terrain
   scene::Engine engine = scene::Engine::kVtk;  // --renderer
   int aa = 8;                                  // --aa (the tiler's samples per pixel per axis)
+  double near_plane = 0;                       // --near-plane, metres; 0: from the eye's height
 };
 
 void run_render(const RenderOptions& o) {
@@ -99,6 +100,7 @@ void run_render(const RenderOptions& o) {
   scene.camera = scene::SceneCamera{o.pose, o.agl, o.fov_y_deg};
   const auto t_scene = Clock::now();
   render::SceneOptions options = render::scene_options(st, o.levels);
+  options.near_plane = o.near_plane;
   options.engine = o.engine;
   options.tiler.aa = o.aa;
   render::SceneRenderer view(scene, settings, options);
@@ -269,6 +271,10 @@ void add_render_command(CLI::App& app) {
                   "heading clockwise from north, pitch above the horizon");
   cmd->add_option("-o,--output", o.output, "PNG file to write")->required();
   auto* fov = cmd->add_option("--fov", o.fov_y_deg, "Vertical field of view, degrees")->capture_default_str();
+  cmd->add_option("--near-plane", o.near_plane,
+                  "Near clipping distance, metres (default: a twentieth of the eye's height above the ground). "
+                  "The tree's order needs no depth buffer; depth-tested orders (--order peel, zbuffer, vtk, sort) "
+                  "resolve depth better with a larger one");
   auto* levels = cmd->add_option("--levels", o.levels, "LOD levels (default: coarsest level 8x8 cells)");
   cmd->add_option("--background", raw->background, "Uniform background R,G,B (0-255) instead of the sky");
   cmd->add_flag("--wireframe", o.wireframe, "Draw triangle edges only");
@@ -281,6 +287,9 @@ void add_render_command(CLI::App& app) {
   add_renderer_options(*cmd, raw->renderer);
   cmd->callback([=] {
     RenderOptions& opt = raw->o;
+    if (opt.near_plane != 0.0 && !(opt.near_plane >= 0.01 && opt.near_plane <= 10000.0)) {
+      throw std::invalid_argument("--near-plane: metres from 0.01 to 10000");
+    }
     const RendererChoice drawn = resolve_renderer(raw->renderer);
     opt.engine = drawn.engine;
     opt.aa = drawn.aa;

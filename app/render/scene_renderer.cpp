@@ -303,7 +303,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   const int* size = renderer_ ? renderer_->window()->GetSize() : nullptr;
   camera_ = scene::make_scene_camera(scene_->frame(), pose, stats.eye_height, fov_y_deg,
                                      size ? std::max(size[0], 1) : settings_.width, size ? std::max(size[1], 1) : settings_.height,
-                                     scene::near_plane_for(clearance));
+                                     options_.near_plane > 0 ? options_.near_plane : scene::near_plane_for(clearance));
   const auto sky = settings_.gradient ? scene::sky_gradient(pose.pitch_deg, fov_y_deg)
                                       : std::array<scene::Rgb, 2>{settings_.background, settings_.background};
   // The density's cells of this view (none for the tiler, which does not draw densities); the

@@ -72,6 +72,10 @@ struct SceneOptions {
   scene::Engine engine = scene::Engine::kVtk;
   tiler::Settings tiler;  // kTiler: aa, texel rate, bands, threads (the size is the RenderSettings')
   density::RefineOptions density;  // how the density is refined (threshold: epsilon, pixels)
+  // The camera's near plane, metres; 0: scene::near_plane_for(the eye's clearance). The tree's
+  // order draws without a depth buffer, so only clipping depends on it; the depth-tested
+  // orders' precision does (24 bits over [near, far]).
+  double near_plane = 0;
 };
 
 // The pipeline's options and the renderer's settings as a resolved style gives them (window,

@@ -185,6 +185,9 @@ TEST(RenderCli, ExportVtpHoldsTheDrawnTrianglesAndTheCamera) {
   }
   EXPECT_EQ(j["window"]["cells"], 1024);
   EXPECT_EQ(j["levels"], 8);
+  EXPECT_NEAR(j["camera"]["near"].get<double>(), 0.05 * (j["camera"]["eye_height"].get<double>() -
+                                                          j["camera"]["ground_height"].get<double>()), 1e-6)
+      << "a twentieth of the eye's height by default";
   std::size_t leaves = 0;
   for (const auto& n : j["lod_histogram"]) leaves += n.get<std::size_t>();
   EXPECT_EQ(leaves, j["leaves"].get<std::size_t>());
@@ -207,6 +210,20 @@ TEST(RenderCli, ExportVtpHoldsTheDrawnTrianglesAndTheCamera) {
   EXPECT_DOUBLE_EQ(fd->GetArray("camera_view_angle")->GetTuple1(0), 50.0);
   ASSERT_NE(fd->GetArray("camera_position"), nullptr);
   EXPECT_NEAR(fd->GetArray("camera_position")->GetComponent(0, 2), j["camera"]["eye"][2].get<double>(), 1e-6);
+}
+
+// The tree's order has no depth buffer: a near plane that clips nothing drawn leaves its
+// picture unchanged, to the byte.
+TEST(RenderCli, NearPlaneIsTheOneGivenAndLeavesTheTreesPictureAloneWhenNothingIsNearer) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const std::string view = "render " + bundled_dem() + " --camera 45.2,6.6,3000,300,-15 --agl --size 160x120 --force";
+  const auto a = dir.path() / "a.png", b = dir.path() / "b.png", stats = dir.path() / "s.json";
+  ASSERT_EQ(run_terravol(view + " -o " + a.string()).status, 0);
+  const auto r = run_terravol(view + " --near-plane 500 -o " + b.string() + " --stats " + stats.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(slurp(stats))["camera"]["near"].get<double>(), 500.0);
+  EXPECT_EQ(test::read_png(a).pixels, test::read_png(b).pixels);
 }
 
 TEST(RenderCli, ExistingOutputIsKeptWithoutForce) {
@@ -254,6 +271,8 @@ TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --background 1,2", "--background");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --threshold 0", "--threshold");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --fov 180", "--fov");
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --near-plane -1", "--near-plane");
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --near-plane 1e9", "--near-plane");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --tint purple", "--tint");
   expect_clean_failure(std::string(TERRAVOL_SOURCE_DIR) + "/missing.hgt --camera 45.5,6.5,3000,0,-10", "missing.hgt");
 }
