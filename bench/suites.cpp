@@ -423,7 +423,7 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
       j["plain_frame_ms"] = to_json(summarize(p));
       j["plain_triangles"] = plain->triangles();
     }
-    char b2[300];
+    char b2[200];
     std::snprintf(b2, sizeof b2, "scaling %s: %zu samples, MRBSP %.1f ms, %zu triangles", t.name.c_str(),
                   (n + 1) * (n + 1), summarize(fr).median, s.triangles);
     say(c, b2);

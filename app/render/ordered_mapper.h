@@ -11,8 +11,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 class vtkShaderProgram;
@@ -75,8 +75,8 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   static constexpr std::string_view kTextureBegin = "//TERRAVOL::Texture::Begin";
   static constexpr std::string_view kTextureEnd = "//TERRAVOL::Texture::End";
   static constexpr std::uint32_t kMinUntexturedRun = 128;
-  // Sorted, disjoint, within the triangles of the next draw.
-  void set_untextured_runs(std::vector<Run> runs) { untextured_ = std::move(runs); }
+  // Sorted, disjoint, within the triangles of the next draw (copied; the buffer is kept).
+  void set_untextured_runs(std::span<const Run> runs) { untextured_.assign(runs.begin(), runs.end()); }
 
   OrderedPolyDataMapper(const OrderedPolyDataMapper&) = delete;
   OrderedPolyDataMapper& operator=(const OrderedPolyDataMapper&) = delete;

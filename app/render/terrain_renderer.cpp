@@ -377,7 +377,8 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
   poly_->SetPolys(triangle_cells(*terrain));
   if (auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_)) {
     // Long runs of merged pieces and box faces: drawn without the texture's fetch.
-    std::vector<OrderedPolyDataMapper::Run> runs;
+    std::vector<OrderedPolyDataMapper::Run>& runs = untextured_runs_;
+    runs.clear();
     if (actor_->GetTexture() != nullptr) {
       const std::size_t n = std::min(levels->size(), static_cast<std::size_t>(triangles));
       for (std::size_t t = 0; t < n;) {
@@ -389,7 +390,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
         t = e == t ? t + 1 : e;
       }
     }
-    ordered->set_untextured_runs(std::move(runs));
+    ordered->set_untextured_runs(runs);
   }
 
   vtkNew<vtkSignedCharArray> level;

@@ -20,6 +20,7 @@
 #include <glm/vec3.hpp>
 
 #include "app/render/legend_image.h"
+#include "app/render/ordered_mapper.h"
 #include "app/scene/style.h"
 #include "app/scene/terrain_colors.h"
 #include "app/scene/volume_layer.h"
@@ -228,6 +229,7 @@ class TerrainRenderer {
   vtkNew<vtkRenderer> labels_renderer_;  // layer 1: the labels over the scene
   std::vector<std::uint32_t> split_terrain_, split_merged_;  // set_frame's buffers (split orders)
   std::vector<std::int8_t> split_levels_;
+  std::vector<OrderedPolyDataMapper::Run> untextured_runs_;  // set_frame's buffer (bsp order)
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkRenderWindow> window_;
 };
