@@ -319,14 +319,28 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
     scene.render(pose, true, 45.0, lod(mrbsp::LodMetric::kError, r % 2 ? 2.0 : 1.0));
     threshold_ms.push_back(ms_since(u0));
   }
-  // An edit of one surface, then the re-merge and the next finished frame (total, of it merge).
+  // An edit of one surface, then the re-merge and the next finished frame (total, of it merge),
+  // and the parts: the surface made again, the merge, the renderer's vertices brought up to
+  // date (the rest of remerge()), the frame.
+  std::map<std::string, std::vector<double>> edit_parts;
   const auto time_edit = [&](const std::function<void(int)>& edit, std::vector<double>& total,
-                             std::vector<double>& merge) {
+                             std::vector<double>& merge, const std::string& name) {
     for (int r = 0; r < std::max(2, c.repeats - 1); ++r) {
       const auto u0 = Clock::now();
       edit(r);
+      const double geometry = ms_since(u0);
+      const auto u1 = Clock::now();
       merge.push_back(scene.remerge().merge_ms);
-      scene.render(pose, true, 45.0, lod_default);
+      const double remerge = ms_since(u1);
+      const auto u2 = Clock::now();
+      const app::render::FrameStats f = scene.render(pose, true, 45.0, lod_default);
+      edit_parts[name + "_frame_traversal"].push_back(f.traversal_ms);
+      edit_parts[name + "_frame_upload"].push_back(f.upload_ms);
+      edit_parts[name + "_frame_draw"].push_back(f.draw_ms);
+      edit_parts[name + "_geometry"].push_back(geometry);
+      edit_parts[name + "_merge"].push_back(merge.back());
+      edit_parts[name + "_vertices"].push_back(remerge - merge.back());
+      edit_parts[name + "_frame"].push_back(ms_since(u2));
       total.push_back(ms_since(u0));
     }
   };
@@ -336,7 +350,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
         slice.value += r % 2 ? 0.0 : 50.0;
         scene.volumes().set_slice(0, 0, slice);
       },
-      slice_ms, slice_merge_ms);
+      slice_ms, slice_merge_ms, "slice_move");
   std::vector<double> iso_ms, iso_merge_ms;
   time_edit(
       [&](int r) {
@@ -344,7 +358,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
         iso.value += r % 2 ? 0.0f : 3.0f;
         scene.volumes().set_isosurface(0, 0, iso);
       },
-      iso_ms, iso_merge_ms);
+      iso_ms, iso_merge_ms, "isovalue_change");
   // A slide of the window by one level-0 cell east and back, with the volumes merged: the tree's
   // slide (keeping what lies in both windows and merging what enters), the moved window read
   // beforehand (as the viewer reads it ahead).
@@ -373,6 +387,7 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
                            {"slice_move_merge_ms", to_json(summarize(slice_merge_ms))},
                            {"isovalue_change_ms", to_json(summarize(iso_ms))},
                            {"isovalue_change_merge_ms", to_json(summarize(iso_merge_ms))}};
+  for (const auto& [name, v] : edit_parts) out["responsiveness_parts_ms"][name] = to_json(summarize(v));
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <vtkOpenGLPolyDataMapper.h>
 #include <vtkPolyData.h>
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -53,9 +54,17 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   // them, instead of VTK uploading every vertex again. The caller does not mark those arrays
   // modified (which would upload everything anyway); the range must lie within the vertices
   // VTK last uploaded.
+  // Ranges given before one draw are joined (the smallest range holding them all).
   void update_vertices(std::size_t first, std::size_t count) {
-    update_first_ = first;
-    update_count_ = count;
+    if (count == 0) return;
+    if (update_count_ == 0) {
+      update_first_ = first;
+      update_count_ = count;
+      return;
+    }
+    const std::size_t end = std::max(update_first_ + update_count_, first + count);
+    update_first_ = std::min(update_first_, first);
+    update_count_ = end - update_first_;
   }
 
   // Runs of triangles (in the cell array's order, counted in triangles) that need no texture:
