@@ -189,6 +189,20 @@ TEST(SceneRenderer, EditedVolumesDrawWhatAPipelineBuiltFromTheEditedSceneDraws) 
     // autopartition), so pieces differ where they meet; the composite may differ by rounding (here 1-3 of 14,400 pixels).
     EXPECT_LT(share_differing(edited.rgb(), fresh.rgb(), 3), 0.002) << "pose at " << pose.alt << " m";
   }
+  // A second edit: its vertices go into the room the first one reserved after the renderer's
+  // vertices, written in place (TerrainRenderer::append_merged_vertices).
+  scene::VolumeSpec again = after;
+  again.isosurfaces[0] = volume::parse_isosurface("111,opacity=0.5");
+  again.slices[0] = volume::parse_slice("agl=280,opacity=0.5");
+  edited.volumes().set_isosurface(0, 0, again.isosurfaces[0]);
+  edited.volumes().set_slice(0, 0, again.slices[0]);
+  edited.remerge();
+  SceneRenderer fresh_again(scene_spec({again}), small_settings(), options(Sliding::kSynchronous));
+  for (const scene::CameraPose& pose : {near, far}) {
+    edited.render(pose, true, 45.0, {});
+    fresh_again.render(pose, true, 45.0, {});
+    EXPECT_LT(share_differing(edited.rgb(), fresh_again.rgb(), 3), 0.002) << "second edit, pose at " << pose.alt << " m";
+  }
   // Hiding the volume removes its surfaces alone; showing it again brings them back.
   edited.volumes().set_visible(0, false);
   EXPECT_EQ(edited.remerge().merged_surfaces, 4u) << "two isosurfaces, the slice and the transmitter marker";
@@ -196,8 +210,8 @@ TEST(SceneRenderer, EditedVolumesDrawWhatAPipelineBuiltFromTheEditedSceneDraws) 
   edited.volumes().set_visible(0, true);
   edited.remerge();
   edited.render(far, true, 45.0, {});
-  fresh.render(far, true, 45.0, {});
-  EXPECT_LT(share_differing(edited.rgb(), fresh.rgb(), 3), 0.002);
+  fresh_again.render(far, true, 45.0, {});
+  EXPECT_LT(share_differing(edited.rgb(), fresh_again.rgb(), 3), 0.002);
 }
 
 }  // namespace
