@@ -1156,7 +1156,9 @@ void TerrainTree::Impl::make_content() {
   release(content);
   release(top_content);
   for (auto& side : outside) side.clear();
-  std::vector<std::uint32_t> cells;
+  // The cells with content and their ancestors, marked in a bitmap (a cell's ancestors are
+  // marked before it is: the walk up stops at the first marked one), then listed in id order.
+  std::vector<std::uint64_t> marked((total_cells + 63) / 64, 0);
   for (std::size_t k = 0; k < slots.size(); ++k) {
     const SlotKey key = slots[k].key;
     if (key >= kOutsideKey0) {
@@ -1164,10 +1166,20 @@ void TerrainTree::Impl::make_content() {
       continue;
     }
     CellName c = cell_name(*this, key / 2);
-    for (; c.level >= 0; --c.level, c.ci /= 2, c.cj /= 2) cells.push_back(cell_id(c.level, c.ci, c.cj));
+    for (; c.level >= 0; --c.level, c.ci /= 2, c.cj /= 2) {
+      const std::uint32_t id = cell_id(c.level, c.ci, c.cj);
+      std::uint64_t& word = marked[id >> 6];
+      const std::uint64_t bit = std::uint64_t{1} << (id & 63u);
+      if (word & bit) break;
+      word |= bit;
+    }
   }
-  std::sort(cells.begin(), cells.end());
-  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  std::vector<std::uint32_t> cells;
+  for (std::size_t w = 0; w < marked.size(); ++w) {
+    for (std::uint64_t b = marked[w]; b != 0; b &= b - 1) {
+      cells.push_back(static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(__builtin_ctzll(b))));
+    }
+  }
   if (cells.empty()) return;
   content_index.build(total_cells, cells);
   content.assign(cells.size(), {-1, -1, -std::numeric_limits<float>::infinity()});
