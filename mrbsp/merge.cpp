@@ -277,8 +277,16 @@ class Distributor {
     split_polygon(
         std::span<const std::uint32_t>(pool_.data() + first, count), eps_,
         [&](std::uint32_t v) { return s_.vertices[v][axis] - offset; },
-        [&](std::uint32_t a, std::uint32_t b, double t) {
+        [&](std::uint32_t a, std::uint32_t b, double) {
           return cache_.get(a, b, plane, [&] {
+            // From the endpoint first in (x, y, z) order, whichever way the polygon runs: the
+            // same edge gives the same bits in every Distributor (chunks of one surface are
+            // distributed apart, distribute_all()), so their pieces meet without a crack.
+            if (std::lexicographical_compare(&s_.vertices[b].x, &s_.vertices[b].x + 3, &s_.vertices[a].x, &s_.vertices[a].x + 3)) {
+              std::swap(a, b);
+            }
+            const double da = s_.vertices[a][axis] - offset, db = s_.vertices[b][axis] - offset;
+            const double t = da / (da - db);
             glm::dvec3 p = glm::mix(s_.vertices[a], s_.vertices[b], t);
             p[axis] = offset;  // exactly in the plane
             s_.vertices.push_back(p);
@@ -1087,6 +1095,111 @@ std::size_t remove_surfaces(BspStore& st, const std::vector<std::uint32_t>& ids,
 
 void TerrainTree::Impl::distribute(SurfacePieces& s) const { Distributor(*this, s).run(); }
 
+void TerrainTree::Impl::distribute_all(const std::vector<SurfacePieces*>& list) const {
+  // A surface of more than kChunk triangles is sent in chunks of about kChunk, each through its
+  // own Distributor on a copy of the surface's input vertices, and the chunks' pieces joined
+  // (theirs by slot, in chunk order: the order one Distributor would give) with their new
+  // vertices renumbered after one another. An edge two chunks split gets a vertex in each, at
+  // the same position (split_axis cuts from the same endpoint). One edit's slice or isosurface
+  // is then distributed on every core instead of one.
+  constexpr std::size_t kChunk = 8192;
+  struct Task {
+    std::size_t surface;
+    std::size_t first, last;  // triangles
+    SurfacePieces part;       // unused when the surface is one chunk
+  };
+  std::vector<Task> tasks;
+  std::vector<std::size_t> first_task(list.size() + 1, 0);
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    first_task[k] = tasks.size();
+    const std::size_t triangles = list[k]->triangles.size() / 3;
+    const std::size_t chunks = std::max<std::size_t>(1, (triangles + kChunk / 2) / kChunk);
+    for (std::size_t c = 0; c < chunks; ++c) tasks.push_back({k, triangles * c / chunks, triangles * (c + 1) / chunks, {}});
+  }
+  first_task[list.size()] = tasks.size();
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, tasks.size(), 1),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+          Task& task = tasks[t];
+          SurfacePieces& s = *list[task.surface];
+          if (first_task[task.surface + 1] - first_task[task.surface] == 1) {
+            distribute(s);
+            continue;
+          }
+          SurfacePieces& part = task.part;
+          part.input_vertices = s.input_vertices;
+          part.input_triangles = task.last - task.first;
+          part.triangles.assign(s.triangles.begin() + static_cast<std::ptrdiff_t>(3 * task.first),
+                                s.triangles.begin() + static_cast<std::ptrdiff_t>(3 * task.last));
+          part.vertices.assign(s.vertices.begin(), s.vertices.begin() + static_cast<std::ptrdiff_t>(s.input_vertices));
+          part.colors.assign(s.colors.begin(), s.colors.begin() + static_cast<std::ptrdiff_t>(s.input_vertices));
+          if (!s.tcoords.empty()) {
+            part.tcoords.assign(s.tcoords.begin(), s.tcoords.begin() + static_cast<std::ptrdiff_t>(s.input_vertices));
+          }
+          distribute(part);
+        }
+      },
+      tbb::simple_partitioner());
+  tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t k) {
+    const std::size_t t0 = first_task[k], t1 = first_task[k + 1];
+    if (t1 - t0 == 1) return;
+    SurfacePieces& s = *list[k];
+    const std::size_t input = s.input_vertices;
+    s.vertices.resize(input);
+    s.colors.resize(input);
+    if (!s.tcoords.empty()) s.tcoords.resize(input);
+    s.dropped = 0;
+    std::vector<std::uint32_t> offset(t1 - t0);  // what a chunk's new vertex ids gain
+    for (std::size_t t = t0; t < t1; ++t) {
+      const SurfacePieces& part = tasks[t].part;
+      offset[t - t0] = static_cast<std::uint32_t>(s.vertices.size() - input);
+      s.vertices.insert(s.vertices.end(), part.vertices.begin() + static_cast<std::ptrdiff_t>(input), part.vertices.end());
+      s.colors.insert(s.colors.end(), part.colors.begin() + static_cast<std::ptrdiff_t>(input), part.colors.end());
+      if (!s.tcoords.empty()) s.tcoords.insert(s.tcoords.end(), part.tcoords.begin() + static_cast<std::ptrdiff_t>(input), part.tcoords.end());
+      s.dropped += part.dropped;
+    }
+    // The chunks' runs joined by slot (a k-way merge of sorted run lists).
+    s.runs.clear();
+    s.counts.clear();
+    s.refs.clear();
+    std::vector<std::size_t> at(t1 - t0, 0);
+    for (;;) {
+      SlotKey slot = std::numeric_limits<SlotKey>::max();
+      bool any = false;
+      for (std::size_t c = 0; c < at.size(); ++c) {
+        const SurfacePieces& part = tasks[t0 + c].part;
+        if (at[c] < part.runs.size()) {
+          slot = std::min(slot, part.runs[at[c]].slot);
+          any = true;
+        }
+      }
+      if (!any) break;
+      s.runs.push_back({slot, static_cast<std::uint32_t>(s.counts.size()), static_cast<std::uint32_t>(s.refs.size())});
+      for (std::size_t c = 0; c < at.size(); ++c) {
+        const SurfacePieces& part = tasks[t0 + c].part;
+        if (at[c] >= part.runs.size() || part.runs[at[c]].slot != slot) continue;
+        const std::size_t r = at[c]++;
+        const std::uint32_t p0 = part.runs[r].piece0;
+        const std::uint32_t p1 = r + 1 < part.runs.size() ? part.runs[r + 1].piece0 : static_cast<std::uint32_t>(part.counts.size());
+        const std::uint32_t ref0 = part.runs[r].ref0;
+        const std::uint32_t ref1 = r + 1 < part.runs.size() ? part.runs[r + 1].ref0 : static_cast<std::uint32_t>(part.refs.size());
+        s.counts.insert(s.counts.end(), part.counts.begin() + p0, part.counts.begin() + p1);
+        for (std::uint32_t q = ref0; q < ref1; ++q) {
+          const std::uint32_t v = part.refs[q];
+          s.refs.push_back(v < input ? v : v + offset[c]);
+        }
+      }
+    }
+    s.runs.shrink_to_fit();
+    s.counts.shrink_to_fit();
+    s.refs.shrink_to_fit();
+    s.vertices.shrink_to_fit();
+    s.colors.shrink_to_fit();
+    s.tcoords.shrink_to_fit();
+  });
+}
+
 void ContentIndex::build(std::size_t cells, const std::vector<std::uint32_t>& sorted_cells) {
   bits.assign((cells + 63) / 64, 0);
   for (std::uint32_t c : sorted_cells) bits[c >> 6] |= std::uint64_t{1} << (c & 63u);
@@ -1396,7 +1509,9 @@ void TerrainTree::Impl::redistribute_all() {
   merge_stats.build_ms = 0.0;
   merge_stats.lazy_built_slots = 0;
   merge_stats.lazy_build_ms = 0.0;
-  tbb::parallel_for(std::size_t{0}, surfaces.size(), [&](std::size_t k) { distribute(surfaces[k].second); });
+  std::vector<SurfacePieces*> list;
+  for (auto& [id, s] : surfaces) list.push_back(&s);
+  distribute_all(list);
   merge_stats.distribute_ms = ms_since(t0);
   std::vector<SlotKey> touched;
   std::vector<std::uint32_t> ids;
@@ -1584,7 +1699,9 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
     if (flip || given(m.surfaces[k].first)) changed.push_back(k);
     if (flip) changed_ids.push_back(m.surfaces[k].first);
   }
-  tbb::parallel_for(std::size_t{0}, changed.size(), [&](std::size_t k) { m.distribute(m.surfaces[changed[k]].second); });
+  std::vector<SurfacePieces*> list;
+  for (std::size_t k : changed) list.push_back(&m.surfaces[k].second);
+  m.distribute_all(list);
   m.merge_stats.distribute_ms = ms_since(t0);
   for (std::size_t k : changed) keys_of(m.surfaces[k].second, touched);
   m.update(changed_ids, std::move(touched));

@@ -298,6 +298,8 @@ struct TerrainTree::Impl {
   // rebuild() makes the slots whose keys are in `dirty` again from every surface's pieces,
   // then the cell content and the merged vertices.
   void distribute(SurfacePieces& s) const;
+  // distribute() of every surface listed, in parallel, large ones in chunks.
+  void distribute_all(const std::vector<SurfacePieces*>& list) const;
   // After the surfaces with ids `changed` were replaced (their pieces distributed anew) and
   // `touched` holds every slot key their old or new pieces reach: removes their old polygons
   // from those slots and inserts the new ones (a slot left empty or worn is built anew from

@@ -122,6 +122,50 @@ TEST(Merge, DrawnMergedAreaIsTheInputAreaAboveTheDrawnTerrainAtEveryThreshold) {
               1e-6 * soup.area);
 }
 
+// A surface of more than two chunks of triangles (TerrainTree::Impl::distribute_all sends it
+// through the tree in parallel parts and joins their pieces): a wavy sheet over the whole
+// window, through the terrain's heights. Every visible part is drawn once, in order.
+TEST(Merge, ALargeSurfaceSentInChunksDrawsItsWholeVisibleAreaInOrder) {
+  std::mt19937 rng(11);
+  TestWindow w(16, [](int, int) { return 0.0f; });
+  TerrainTree tree = hilly_tree(rng, w);
+  Soup sheet;
+  constexpr int kCols = 120, kRows = 110;  // 26,400 triangles
+  const auto at = [](int i, int j) {
+    const double x = -50.0 + 1700.0 * i / kCols, y = -50.0 + 1700.0 * j / kRows;
+    return glm::dvec3(x, y, 260.0 + 120.0 * std::sin(x / 170.0) * std::cos(y / 230.0));
+  };
+  for (int j = 0; j < kRows; ++j)
+    for (int i = 0; i < kCols; ++i) {
+      sheet.add(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      sheet.add(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  const MergeStats stats = tree.merge(sheet.v, sheet.c, sheet.t);
+  EXPECT_EQ(stats.input_triangles, sheet.size());
+  EXPECT_GT(stats.dropped_pieces, 0u) << "the sheet dips below the terrain";
+  Camera c;
+  c.eye = {-400.0, -300.0, 900.0};
+  Frame f;
+  for (float t : {1.0f, 64.0f}) {
+    TraversalOptions o;
+    o.cull = false;
+    o.threshold_px = t;
+    tree.traverse(c, o, f);
+    const double expected = test::area_above_drawn_terrain(tree, f, sheet, kX0, kX1, kX0, kX1);
+    EXPECT_GT(expected, 0.2 * sheet.area);
+    EXPECT_NEAR(drawn_merged_area(tree, f), expected, 1e-6 * sheet.area) << "threshold " << t;
+  }
+  std::uniform_real_distribution<double> xy(0.0, 1600.0), dir(-1.0, 1.0);
+  for (int trial = 0; trial < 6; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), 450.0 + 100.0 * trial);
+    Camera cam = camera_at(eye, {dir(rng), dir(rng), -0.5});
+    TraversalOptions o;
+    o.cull = trial % 2 == 0;
+    tree.traverse(cam, o, f);
+    EXPECT_EQ(order_violations(tree, f, eye, 100, rng, true), 0) << "trial " << trial;
+  }
+}
+
 // Culling by content boxes: from cameras inside and beside the merged triangles, low over the
 // ground and looking up, down and level, the merged area drawn inside the view frustum is the
 // input's visible area inside it (the reference clips the inputs to the frustum, derived by
