@@ -141,6 +141,11 @@ void SceneRenderer::sync_vertices(TerrainRenderer& renderer) const {
   const mrbsp::TerrainTree& tree = scene_->tree();
   const std::vector<glm::vec3>& positions = tree.positions();
   if (renderer.vertex_version() != tree.merged_version() || renderer.vertex_count() > positions.size()) {
+    // A renumbering over the same terrain (a compaction after edits): the merged vertices alone.
+    if (renderer.replace_merged_vertices(positions, tree.merged_base(), tree.merged_colors())) {
+      renderer.set_vertex_version(tree.merged_version());
+      return;
+    }
     const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
     renderer.replace_vertices(positions, all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
   } else if (renderer.vertex_count() < positions.size()) {

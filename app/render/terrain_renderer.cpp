@@ -596,14 +596,50 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
     grow(poly_->GetPointData()->GetTCoords(), none.data(), sizeof(glm::vec2));
   }
   // The frames' own vertices after the new ones, and room for about three more appends as
-  // large as this one (an edit's), to be written in place (above).
+  // large as this one (an edit's) or a sixteenth of the vertices (lazily built pieces come in
+  // small appends between an edit's large ones), to be written in place (above).
   if (ordered != nullptr && !split_orders()) {
-    reserve_tail(std::max(tail_, 3 * positions.size()));
+    reserve_tail(std::max({tail_, 3 * positions.size(), point_rgba_.size() / 16}));
   } else if (tail_ > 0) {
     reserve_tail(tail_);
   }
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
+}
+
+bool TerrainRenderer::replace_merged_vertices(std::span<const glm::vec3> positions, std::size_t merged_base,
+                                              std::span<const glm::u8vec4> colors) {
+  auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
+  const std::size_t n = positions.size(), held = point_rgba_.size();
+  if (ordered == nullptr || split_orders() || merged_base > held || merged_base > n || colors.size() != n - merged_base ||
+      n > held + tail_) {
+    return false;
+  }
+  auto* xyz = static_cast<float*>(poly_->GetPoints()->GetData()->GetVoidPointer(0));
+  if (std::memcmp(xyz, positions.data(), merged_base * sizeof(glm::vec3)) != 0) return false;
+  // The room after the terrain's vertices holds merged vertices or placeholders, whose normals
+  // (+z) and texture coordinates (-1, -1) are what merged vertices have: positions and colours
+  // are all that change.
+  poly_->SetPolys(vtkNew<vtkCellArray>());
+  poly_->GetCellData()->Initialize();
+  std::memcpy(xyz + 3 * merged_base, positions.data() + merged_base, (n - merged_base) * sizeof(glm::vec3));
+  point_rgba_.resize(n);
+  for (std::size_t k = merged_base; k < n; ++k) {
+    const glm::u8vec4& c = colors[k - merged_base];
+    point_rgba_[k] = {c.r, c.g, c.b, c.a};
+  }
+  std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * merged_base,
+              point_rgba_.data() + merged_base, (n - merged_base) * sizeof(scene::Rgba));
+  shade_.resize(n);
+  std::fill(shade_.begin() + static_cast<std::ptrdiff_t>(merged_base), shade_.end(), 1.0f);
+  tail_ = held + tail_ - n;
+  if (std::any_of(point_rgba_.begin() + static_cast<std::ptrdiff_t>(merged_base), point_rgba_.end(),
+                  [](const scene::Rgba& c) { return c[3] != 255; })) {
+    ordered->set_blending(true);
+  }
+  ordered->update_vertices(merged_base, n - merged_base);
+  poly_->Modified();
+  return true;
 }
 
 void TerrainRenderer::release_vertices() {

@@ -144,6 +144,15 @@ class TerrainRenderer {
   // vertex_shading gives merged vertices). The triangles drawn stay valid. Throws
   // std::invalid_argument when the counts differ.
   void append_merged_vertices(std::span<const glm::vec3> positions, std::span<const glm::u8vec4> colors);
+  // After the tree renumbered its merged vertices but kept its terrain (a compaction after
+  // edits, a merge of everything): `positions` are all of the tree's positions(), the first
+  // `merged_base` of them the terrain's, `colors` the merged ones' colours. When the terrain's
+  // are the ones held (compared byte for byte) and all fit in the room reserved, the merged
+  // ones are written in place and only they uploaded, and true is returned; else false, and
+  // nothing changed (use replace_vertices). The triangle list is emptied until the next
+  // set_frame().
+  bool replace_merged_vertices(std::span<const glm::vec3> positions, std::size_t merged_base,
+                               std::span<const glm::u8vec4> colors);
   std::size_t vertex_count() const { return point_rgba_.size(); }  // the tree's, not the frame's own
   std::size_t transient_capacity() const { return tail_; }
   // Which TerrainTree::merged_version() the vertices are of (the caller's bookkeeping:
