@@ -59,6 +59,14 @@ struct PlaneD {
 
 enum class Side { kBack, kFront, kCoplanar, kSpanning };
 
+// The side of a polygon with vertices in front of the plane (`front`) and behind it (`back`).
+Side side_of(bool front, bool back) {
+  if (front && back) return Side::kSpanning;
+  if (front) return Side::kFront;
+  if (back) return Side::kBack;
+  return Side::kCoplanar;
+}
+
 // The vertex made where an edge crosses a plane, once per (edge, plane): a flat open-addressing
 // map from (lower vertex, higher vertex, plane id) to the vertex. Written by hand because the
 // standard unordered_map costs a node allocation per entry and this is the merge's hottest map.
@@ -603,10 +611,7 @@ class SlotBuilder {
       front |= s > eps_;
       back |= s < -eps_;
     }
-    if (front && back) return Side::kSpanning;
-    if (front) return Side::kFront;
-    if (back) return Side::kBack;
-    return Side::kCoplanar;
+    return side_of(front, back);
   }
 
   // Newell's normal; false for a degenerate (zero-area) polygon.
@@ -722,10 +727,7 @@ class SlotBuilder {
       front |= s > tolerance;
       back |= s < -tolerance;
     }
-    if (front && back) return Side::kSpanning;
-    if (front) return Side::kFront;
-    if (back) return Side::kBack;
-    return Side::kCoplanar;
+    return side_of(front, back);
   }
 
   // The score of a splitter (kW per span plus the imbalance) over every stride-th of the

@@ -331,26 +331,17 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     const bool grown = own > tail_;
     if (grown) reserve_tail(std::max({own, 2 * tail_, std::size_t{4096}}));
     const std::size_t base = point_rgba_.size();
-    vtkDataArray* xyz = poly_->GetPoints()->GetData();
-    std::memcpy(static_cast<float*>(xyz->GetVoidPointer(0)) + 3 * base, frame.transient_positions.data(), own * sizeof(glm::vec3));
-    std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * base,
-                frame.transient_colors.data(), own * sizeof(glm::u8vec4));
+    write_vertices(base, frame.transient_positions, frame.transient_colors.data());
     auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
     if (ordered != nullptr && !grown) {
       ordered->update_vertices(base, own);
     } else {
-      xyz->Modified();
+      poly_->GetPoints()->GetData()->Modified();
       poly_->GetPoints()->Modified();
       poly_->GetPointData()->GetScalars()->Modified();
       if (split_orders()) merged_poly_->Modified();
     }
-    if (ordered != nullptr && !ordered->blending()) {
-      for (const glm::u8vec4& c : frame.transient_colors) {
-        if (c.a == 255) continue;
-        ordered->set_blending(true);
-        break;
-      }
-    }
+    blend_if_translucent(frame.transient_colors);
   }
   // The split orders draw the merged triangles with a second actor: the terrain's list keeps
   // the rest, in the frame's order (buffers reused from frame to frame).
@@ -557,10 +548,7 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   std::vector<scene::Rgba> rgba(colors.size());
   for (std::size_t k = 0; k < colors.size(); ++k) rgba[k] = {colors[k].r, colors[k].g, colors[k].b, colors[k].a};
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
-  // Translucent newcomers turn blending on (it stays on: what was translucent still is).
-  if (ordered != nullptr && std::any_of(rgba.begin(), rgba.end(), [](const scene::Rgba& c) { return c[3] != 255; })) {
-    ordered->set_blending(true);
-  }
+  blend_if_translucent(colors);
   shade_.resize(shade_.size() + positions.size(), 1.0f);
   point_rgba_.insert(point_rgba_.end(), rgba.begin(), rgba.end());
   if (ordered != nullptr && !split_orders() && positions.size() <= tail_) {
@@ -568,10 +556,7 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
     // texture coordinates: positions and colours written in place, and only they uploaded
     // (update_vertices). Marking the arrays modified would make VTK upload every vertex again,
     // about 30 ms of the first frame after an edit of the benchmark's volumes over N44W072.
-    std::memcpy(static_cast<float*>(poly_->GetPoints()->GetData()->GetVoidPointer(0)) + 3 * old_count, positions.data(),
-                positions.size() * sizeof(glm::vec3));
-    std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * old_count,
-                rgba.data(), rgba.size() * sizeof(scene::Rgba));
+    write_vertices(static_cast<std::size_t>(old_count), positions, rgba.data());
     tail_ -= positions.size();
     ordered->update_vertices(static_cast<std::size_t>(old_count), positions.size());
     return;
@@ -607,6 +592,19 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   if (split_orders()) merged_poly_->Modified();
 }
 
+void TerrainRenderer::write_vertices(std::size_t first, std::span<const glm::vec3> positions, const void* rgba) {
+  std::memcpy(static_cast<float*>(poly_->GetPoints()->GetData()->GetVoidPointer(0)) + 3 * first, positions.data(),
+              positions.size() * sizeof(glm::vec3));
+  std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * first, rgba,
+              4 * positions.size());
+}
+
+void TerrainRenderer::blend_if_translucent(std::span<const glm::u8vec4> colors) {
+  auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
+  if (ordered == nullptr || ordered->blending()) return;
+  if (std::any_of(colors.begin(), colors.end(), [](const glm::u8vec4& c) { return c.a != 255; })) ordered->set_blending(true);
+}
+
 bool TerrainRenderer::replace_merged_vertices(std::span<const glm::vec3> positions, std::size_t merged_base,
                                               std::span<const glm::u8vec4> colors) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
@@ -622,21 +620,16 @@ bool TerrainRenderer::replace_merged_vertices(std::span<const glm::vec3> positio
   // are all that change.
   poly_->SetPolys(vtkNew<vtkCellArray>());
   poly_->GetCellData()->Initialize();
-  std::memcpy(xyz + 3 * merged_base, positions.data() + merged_base, (n - merged_base) * sizeof(glm::vec3));
   point_rgba_.resize(n);
   for (std::size_t k = merged_base; k < n; ++k) {
     const glm::u8vec4& c = colors[k - merged_base];
     point_rgba_[k] = {c.r, c.g, c.b, c.a};
   }
-  std::memcpy(static_cast<unsigned char*>(poly_->GetPointData()->GetScalars()->GetVoidPointer(0)) + 4 * merged_base,
-              point_rgba_.data() + merged_base, (n - merged_base) * sizeof(scene::Rgba));
+  write_vertices(merged_base, positions.subspan(merged_base), point_rgba_.data() + merged_base);
   shade_.resize(n);
   std::fill(shade_.begin() + static_cast<std::ptrdiff_t>(merged_base), shade_.end(), 1.0f);
   tail_ = held + tail_ - n;
-  if (std::any_of(point_rgba_.begin() + static_cast<std::ptrdiff_t>(merged_base), point_rgba_.end(),
-                  [](const scene::Rgba& c) { return c[3] != 255; })) {
-    ordered->set_blending(true);
-  }
+  blend_if_translucent(colors);
   ordered->update_vertices(merged_base, n - merged_base);
   poly_->Modified();
   return true;

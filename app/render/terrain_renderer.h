@@ -206,6 +206,12 @@ class TerrainRenderer {
   // for a frame's own (at the origin, clear, texture coordinates (-1, -1) so that the shader
   // takes their colour) and marks them modified. Sets tail_.
   void reserve_tail(std::size_t capacity);
+  // Positions and RGBA bytes (4 per vertex) of vertices first .. first + positions.size() into
+  // the arrays, which must hold them; nothing is marked modified.
+  void write_vertices(std::size_t first, std::span<const glm::vec3> positions, const void* rgba);
+  // Translucent newcomers turn the ordered mapper's blending on (it stays on: what was
+  // translucent still is).
+  void blend_if_translucent(std::span<const glm::u8vec4> colors);
   bool split_orders() const {
     return settings_.order != scene::DrawOrder::kBsp && settings_.order != scene::DrawOrder::kZBuffer;
   }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <random>
 
 #include "mrbsp/terrain_tree.h"
@@ -65,6 +66,21 @@ Camera camera_at(const glm::dvec3& eye, glm::dvec3 forward) { return test::looki
 // The window's footprint: 16 cells of 100 m from the origin.
 constexpr double kX0 = 0.0, kX1 = 1600.0;
 
+// At each LOD threshold, with culling off, the merged area drawn from `c` is the soup's area
+// above the terrain drawn there (brute-force clipping), and a fair share of the soup is drawn.
+void expect_drawn_area_at_thresholds(const TerrainTree& tree, const Camera& c, const Soup& soup,
+                                     std::initializer_list<float> thresholds, Frame& f) {
+  for (float t : thresholds) {
+    TraversalOptions o;
+    o.cull = false;
+    o.threshold_px = t;
+    tree.traverse(c, o, f);
+    const double expected = test::area_above_drawn_terrain(tree, f, soup, kX0, kX1, kX0, kX1);
+    EXPECT_GT(expected, 0.2 * soup.area);
+    EXPECT_NEAR(drawn_merged_area(tree, f), expected, 1e-6 * soup.area) << "threshold " << t;
+  }
+}
+
 TEST(Merge, MergedAndTerrainTrianglesAreInBackToFrontOrderFromRandomEyes) {
   std::mt19937 rng(77);
   TestWindow w(16, [](int, int) { return 0.0f; });
@@ -105,15 +121,7 @@ TEST(Merge, DrawnMergedAreaIsTheInputAreaAboveTheDrawnTerrainAtEveryThreshold) {
   Camera c;
   c.eye = {-400.0, -300.0, 700.0};
   Frame f;
-  for (float t : {0.5f, 4.0f, 64.0f, 10000.0f}) {
-    TraversalOptions o;
-    o.cull = false;
-    o.threshold_px = t;
-    tree.traverse(c, o, f);
-    const double expected = test::area_above_drawn_terrain(tree, f, soup, kX0, kX1, kX0, kX1);
-    EXPECT_GT(expected, 0.2 * soup.area);
-    EXPECT_NEAR(drawn_merged_area(tree, f), expected, 1e-6 * soup.area) << "threshold " << t;
-  }
+  expect_drawn_area_at_thresholds(tree, c, soup, {0.5f, 4.0f, 64.0f, 10000.0f}, f);
   TraversalOptions full;
   full.cull = false;
   full.full_res = true;
@@ -146,15 +154,7 @@ TEST(Merge, ALargeSurfaceSentInChunksDrawsItsWholeVisibleAreaInOrder) {
   Camera c;
   c.eye = {-400.0, -300.0, 900.0};
   Frame f;
-  for (float t : {1.0f, 64.0f}) {
-    TraversalOptions o;
-    o.cull = false;
-    o.threshold_px = t;
-    tree.traverse(c, o, f);
-    const double expected = test::area_above_drawn_terrain(tree, f, sheet, kX0, kX1, kX0, kX1);
-    EXPECT_GT(expected, 0.2 * sheet.area);
-    EXPECT_NEAR(drawn_merged_area(tree, f), expected, 1e-6 * sheet.area) << "threshold " << t;
-  }
+  expect_drawn_area_at_thresholds(tree, c, sheet, {1.0f, 64.0f}, f);
   std::uniform_real_distribution<double> xy(0.0, 1600.0), dir(-1.0, 1.0);
   for (int trial = 0; trial < 6; ++trial) {
     const glm::dvec3 eye(xy(rng), xy(rng), 450.0 + 100.0 * trial);
