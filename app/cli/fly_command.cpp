@@ -166,6 +166,7 @@ void run_fly(const FlyOptions& o) {
   if (tiled) {  // frames of another renderer or sampling are other frames (absent: VTK, as before)
     manifest["renderer"] = scene::engine_name(o.drawn.engine);
     manifest["aa"] = o.drawn.aa;
+    manifest["texel_rate"] = o.drawn.texel_rate;
   }
   if (video) {
     if (o.resume) throw std::invalid_argument("--resume: only a PNG folder export resumes; a video is written whole");
@@ -254,6 +255,7 @@ void run_fly(const FlyOptions& o) {
   render::SceneOptions scene_opts = render::scene_options(st);
   scene_opts.engine = o.drawn.engine;
   scene_opts.tiler.aa = o.drawn.aa;
+  scene_opts.tiler.texel_rate = o.drawn.texel_rate;
   scene_opts.density.threshold_px *= factor;  // in output pixels, like the LOD threshold
   render::SceneRenderer renderer(std::move(mosaic), scene, settings, scene_opts);
 

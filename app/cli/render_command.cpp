@@ -60,6 +60,7 @@ struct RenderOptions {
   std::vector<scene::ObjectSpec> objects;  // models placed on the terrain
   scene::Engine engine = scene::Engine::kVtk;  // --renderer
   int aa = 8;                                  // --aa (the tiler's samples per pixel per axis)
+  double texel_rate = tiler::Settings{}.texel_rate;  // --texel-rate (the tiler's texture shading)
   double near_plane = 0;                       // --near-plane, metres; 0: from the eye's height
 };
 
@@ -103,6 +104,7 @@ void run_render(const RenderOptions& o) {
   options.near_plane = o.near_plane;
   options.engine = o.engine;
   options.tiler.aa = o.aa;
+  options.tiler.texel_rate = o.texel_rate;
   render::SceneRenderer view(scene, settings, options);
   const double scene_ms = ms_since(t_scene);
   const bool tiled = o.engine == scene::Engine::kTiler;
@@ -293,6 +295,7 @@ void add_render_command(CLI::App& app) {
     const RendererChoice drawn = resolve_renderer(raw->renderer);
     opt.engine = drawn.engine;
     opt.aa = drawn.aa;
+    opt.texel_rate = drawn.texel_rate;
     if (opt.engine == scene::Engine::kTiler) {
       if (opt.wireframe || opt.lod_colors) {
         throw std::invalid_argument(std::string("--renderer tiler: draws filled triangles only (no ") +

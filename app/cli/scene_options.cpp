@@ -1,5 +1,6 @@
 #include "app/cli/scene_options.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -106,12 +107,24 @@ void add_renderer_options(CLI::App& cmd, RendererArgs& args) {
       ->capture_default_str();
   args.aa_option = cmd.add_option("--aa", args.aa, "With --renderer tiler: samples per pixel per axis, 1, 2, 4 or 8")
                        ->capture_default_str();
+  args.texel_rate_option =
+      cmd.add_option("--texel-rate", args.texel_rate,
+                     "With --renderer tiler: texture shading points per texel a pixel spans, per axis, where a pixel "
+                     "spans many texels of the terrain (0: every sample shaded, exact supersampling)")
+          ->capture_default_str();
 }
 
 RendererChoice resolve_renderer(const RendererArgs& args) {
-  RendererChoice c{scene::parse_engine(args.renderer), scene::parse_aa(args.aa)};
-  if (c.engine == scene::Engine::kVtk && args.aa_option != nullptr && args.aa_option->count() > 0) {
+  RendererChoice c{scene::parse_engine(args.renderer), scene::parse_aa(args.aa), args.texel_rate};
+  const auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
+  if (c.engine == scene::Engine::kVtk && given(args.aa_option)) {
     throw std::invalid_argument("--aa: needs --renderer tiler (VTK antialiases by supersampling: fly --samples)");
+  }
+  if (c.engine == scene::Engine::kVtk && given(args.texel_rate_option)) {
+    throw std::invalid_argument("--texel-rate: needs --renderer tiler");
+  }
+  if (!(c.texel_rate >= 0.0) || !std::isfinite(c.texel_rate)) {
+    throw std::invalid_argument("--texel-rate " + std::to_string(c.texel_rate) + ": expected a finite number >= 0");
   }
   return c;
 }

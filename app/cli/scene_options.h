@@ -12,6 +12,7 @@
 
 #include "app/scene/scene_file.h"
 #include "app/scene/style.h"
+#include "tiler/renderer.h"
 
 namespace terravol::app::cli {
 
@@ -51,17 +52,21 @@ CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold);
 // The scene objects of --object texts (scene::parse_object; the files are read later).
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts);
 
-// --renderer vtk|tiler and --aa 1|2|4|8, as given (render and fly share them).
+// --renderer vtk|tiler, --aa 1|2|4|8 and --texel-rate, as given (render and fly share them).
 struct RendererArgs {
   std::string renderer = "vtk", aa = "8";
+  double texel_rate = tiler::Settings{}.texel_rate;
   CLI::Option* aa_option = nullptr;
+  CLI::Option* texel_rate_option = nullptr;
 };
 void add_renderer_options(CLI::App& cmd, RendererArgs& args);
 // What they name. Throws std::invalid_argument (one line naming the option and the text) for a
-// bad value, or --aa given without --renderer tiler.
+// bad value (a --texel-rate that is negative or not finite), or --aa or --texel-rate given
+// without --renderer tiler.
 struct RendererChoice {
   scene::Engine engine = scene::Engine::kVtk;
   int aa = 8;
+  double texel_rate = tiler::Settings{}.texel_rate;  // tiler::Settings::texel_rate
 };
 RendererChoice resolve_renderer(const RendererArgs& args);
 // With the tiler: throws std::invalid_argument naming --size and --aa unless width * aa and

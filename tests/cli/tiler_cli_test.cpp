@@ -76,6 +76,28 @@ TEST(TilerCli, RendersTheBundledDemWithoutAnXDisplay) {
             320u * 180u * 16u);
 }
 
+// --texel-rate reaches the tiler: 0 shades every sample of the terrain on its own, so more
+// shading points than the default, which shades a fragment once unless its pixel spans four
+// texels or more.
+TEST(TilerCli, TexelRateSetsHowFinelyTheTerrainTextureIsShaded) {
+  test::TempDir dir;
+  const auto shading = [&](const std::string& rate, const std::string& name) {
+    const auto png = dir.path() / (name + ".png"), stats = dir.path() / (name + ".json");
+    const auto r = run_terravol_under("env -u DISPLAY", "render " + bundled_dem() +
+                                                            " --camera 45.1,6.3,1500,35,-8 --size 160x90 --renderer tiler "
+                                                            "--aa 4" + rate + " -o " + png.string() + " --stats " + stats.string());
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::ifstream in(stats);
+    return nlohmann::json::parse(in)["tiler"];
+  };
+  const nlohmann::json every = shading(" --texel-rate 0", "every"), usual = shading("", "usual");
+  EXPECT_EQ(every["texel_rate"].get<double>(), 0.0);
+  EXPECT_EQ(usual["texel_rate"].get<double>(), 0.25);
+  // Every covered sample its own shading point at 0 (the view has no translucent triangles).
+  EXPECT_EQ(every["shading_points"].get<std::uint64_t>(), every["samples_covered"].get<std::uint64_t>());
+  EXPECT_LT(usual["shading_points"].get<std::uint64_t>(), every["shading_points"].get<std::uint64_t>() / 4);
+}
+
 // The same view drawn by VTK (one sample a pixel) and by the tiler: at one sample a pixel they
 // sample the same centres with the same fill rule, so they agree almost everywhere; at 8 x 8
 // they agree wherever the picture is smooth (away from edges), where antialiasing changes
@@ -147,6 +169,7 @@ TEST(TilerCli, FlyWritesAntialiasedFramesWithoutAnXDisplay) {
   const nlohmann::json manifest = nlohmann::json::parse(in);
   EXPECT_EQ(manifest["renderer"], "tiler");
   EXPECT_EQ(manifest["aa"], 2);
+  EXPECT_EQ(manifest["texel_rate"].get<double>(), 0.25);
   // Resuming with other samples, or with VTK, would mix frames of two renderings.
   const std::string again = "fly " + path.string() + " -o " + frames.string() + "/ --fps 2 --size 160x90 --resume";
   auto other = run_terravol_under("env -u DISPLAY", again + " --renderer tiler --aa 4");
@@ -175,6 +198,10 @@ TEST(TilerCli, BadRendererAndAaValuesFailWithOneLine) {
       {" --renderer tiler --lod-colors", "--lod-colors"},
       {" --renderer tiler --export-vtp " + (dir.path() / "x.vtp").string(), "--export-vtp"},
       {" --renderer tiler --aa 8 --size 2100x100", "--size 2100x100"},
+      {" --renderer tiler --texel-rate -1", "--texel-rate"},
+      {" --renderer tiler --texel-rate inf", "--texel-rate"},
+      {" --renderer tiler --texel-rate nan", "--texel-rate"},
+      {" --texel-rate 1", "--texel-rate"},
   };
   for (const auto& [args, names] : cases) {
     const auto r = run_terravol_under("env -u DISPLAY", base + args);
