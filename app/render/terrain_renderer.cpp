@@ -178,6 +178,10 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   actor_->ForceOpaqueOn();  // drawn in the opaque pass, in our order
   vtkProperty* property = actor_->GetProperty();
   property->LightingOff();  // the shading is baked into the colours (terrain_colors.h)
+  // VTK uploads point normals only for Gouraud and Phong interpolation, and no unlit shader
+  // reads them; flat keeps them off the GL buffers (the normals stay in the polydata for
+  // --export-vtp). Images byte-identical; a 4096-cell window's render 2.69 GB RSS -> 2.49 GB.
+  property->SetInterpolationToFlat();
   property->SetColor(1.0, 1.0, 1.0);
   if (settings.wireframe) property->SetRepresentationToWireframe();
 
