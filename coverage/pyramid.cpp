@@ -82,22 +82,30 @@ constexpr std::uint64_t rect_mask(int i0, int i1, int j0, int j1) {
 // mask64: every value must fit in 63 bits (|v| + 7 |sa| + 7 |sb| < 2^62).
 std::uint64_t mask64(i64 v, i64 sa, i64 sb) {
 #if TERRAVOL_COVERAGE_SIMD
+  // Two rows at a time: the high halves of each row's eight values (their signs) gathered into
+  // 32-bit lanes, packed with saturation (which keeps signs) to sixteen bytes, and their signs
+  // taken at once.
   __m128i r0 = _mm_set_epi64x(v + sa, v);
   __m128i r1 = _mm_add_epi64(r0, _mm_set1_epi64x(2 * sa));
   __m128i r2 = _mm_add_epi64(r0, _mm_set1_epi64x(4 * sa));
   __m128i r3 = _mm_add_epi64(r0, _mm_set1_epi64x(6 * sa));
   const __m128i step = _mm_set1_epi64x(sb);
-  std::uint64_t m = 0;
-  for (int j = 0; j < 8; ++j) {
-    const int neg = _mm_movemask_pd(_mm_castsi128_pd(r0)) | (_mm_movemask_pd(_mm_castsi128_pd(r1)) << 2) |
-                    (_mm_movemask_pd(_mm_castsi128_pd(r2)) << 4) | (_mm_movemask_pd(_mm_castsi128_pd(r3)) << 6);
-    m |= static_cast<std::uint64_t>(~neg & 0xFF) << (8 * j);
+  const auto row = [&] {
+    const __m128i lo = _mm_castps_si128(_mm_shuffle_ps(_mm_castsi128_ps(r0), _mm_castsi128_ps(r1), _MM_SHUFFLE(3, 1, 3, 1)));
+    const __m128i hi = _mm_castps_si128(_mm_shuffle_ps(_mm_castsi128_ps(r2), _mm_castsi128_ps(r3), _MM_SHUFFLE(3, 1, 3, 1)));
     r0 = _mm_add_epi64(r0, step);
     r1 = _mm_add_epi64(r1, step);
     r2 = _mm_add_epi64(r2, step);
     r3 = _mm_add_epi64(r3, step);
+    return _mm_packs_epi32(lo, hi);
+  };
+  std::uint64_t neg = 0;
+  for (int j = 0; j < 8; j += 2) {
+    const __m128i a = row();
+    const __m128i b = row();
+    neg |= static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_packs_epi16(a, b)))) << (8 * j);
   }
-  return m;
+  return ~neg;
 #else
   std::uint64_t m = 0;
   for (int j = 0; j < 8; ++j)
@@ -111,18 +119,25 @@ std::uint64_t mask64(i64 v, i64 sa, i64 sb) {
 // (|v| + 7 |sa| + 7 |sb| < 2^31).
 std::uint64_t mask32(i64 v, i64 sa, i64 sb, int j0, int j1) {
 #if TERRAVOL_COVERAGE_SIMD
-  const auto v0 = static_cast<std::int32_t>(v + j0 * sb), a = static_cast<std::int32_t>(sa);
+  // Two rows at a time from row j0 & ~1 (so also rows just outside j0..j1, whose values fit
+  // as well: within the tile), packed with saturation to sixteen bytes whose signs are taken
+  // at once.
+  const int first = j0 & ~1;
+  const auto v0 = static_cast<std::int32_t>(v + first * sb), a = static_cast<std::int32_t>(sa);
   __m128i lo = _mm_set_epi32(v0 + 3 * a, v0 + 2 * a, v0 + a, v0);
   __m128i hi = _mm_add_epi32(lo, _mm_set1_epi32(4 * a));
   const __m128i step = _mm_set1_epi32(static_cast<std::int32_t>(sb));
-  std::uint64_t m = 0;
-  for (int j = j0; j <= j1; ++j) {
-    const int neg = _mm_movemask_ps(_mm_castsi128_ps(lo)) | (_mm_movemask_ps(_mm_castsi128_ps(hi)) << 4);
-    m |= static_cast<std::uint64_t>(~neg & 0xFF) << (8 * j);
+  std::uint64_t neg = 0;
+  for (int j = first; j <= j1; j += 2) {
+    const __m128i r0 = _mm_packs_epi32(lo, hi);
     lo = _mm_add_epi32(lo, step);
     hi = _mm_add_epi32(hi, step);
+    const __m128i r1 = _mm_packs_epi32(lo, hi);
+    lo = _mm_add_epi32(lo, step);
+    hi = _mm_add_epi32(hi, step);
+    neg |= static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_packs_epi16(r0, r1)))) << (8 * j);
   }
-  return m;
+  return ~neg & row_mask(j0, j1);
 #else
   return mask64(v, sa, sb) & row_mask(j0, j1);
 #endif
@@ -164,26 +179,34 @@ struct SmallLanes {
 
 template <int N>
 [[gnu::always_inline]] inline std::uint64_t small_mask(const SmallEdge* e, const SmallLanes* l, i64 ox, i64 oy, int j0, int j1) {
+  // Rows in pairs from j0 & ~1 (a row just outside j0..j1 lies in the tile, near the polygon,
+  // so its values fit as well), each pair's sixteen values packed with saturation to bytes
+  // whose signs are taken at once (as mask32).
+  const int first = j0 & ~1;
   __m128i lo[N], hi[N];
   for (int k = 0; k < N; ++k) {
-    lo[k] = _mm_add_epi32(_mm_set1_epi32(static_cast<std::int32_t>(e[k].c + e[k].a * ox + e[k].b * (oy + j0))), l[k].lane);
+    lo[k] = _mm_add_epi32(_mm_set1_epi32(static_cast<std::int32_t>(e[k].c + e[k].a * ox + e[k].b * (oy + first))), l[k].lane);
     hi[k] = _mm_add_epi32(lo[k], l[k].four_a);
   }
-  std::uint64_t m = 0;
-  for (int j = j0; j <= j1; ++j) {
+  const auto row = [&] {
     __m128i lo_or = lo[0], hi_or = hi[0];
     for (int k = 1; k < N; ++k) {
       lo_or = _mm_or_si128(lo_or, lo[k]);
       hi_or = _mm_or_si128(hi_or, hi[k]);
     }
-    const int neg = _mm_movemask_ps(_mm_castsi128_ps(lo_or)) | (_mm_movemask_ps(_mm_castsi128_ps(hi_or)) << 4);
-    m |= static_cast<std::uint64_t>(~neg & 0xFF) << (8 * j);
     for (int k = 0; k < N; ++k) {
       lo[k] = _mm_add_epi32(lo[k], l[k].step);
       hi[k] = _mm_add_epi32(hi[k], l[k].step);
     }
+    return _mm_packs_epi32(lo_or, hi_or);
+  };
+  std::uint64_t neg = 0;
+  for (int j = first; j <= j1; j += 2) {
+    const __m128i a = row();
+    const __m128i b = row();
+    neg |= static_cast<std::uint64_t>(static_cast<std::uint32_t>(_mm_movemask_epi8(_mm_packs_epi16(a, b)))) << (8 * j);
   }
-  return m;
+  return ~neg & row_mask(j0, j1);
 }
 #else
 template <int N>
