@@ -100,14 +100,38 @@ constexpr std::uint64_t rect_mask(int x0, int w, int y0, int h) {
 constexpr std::uint64_t kX1 = 0xAAAAAAAAAAAAAAAAull, kX2 = 0xCCCCCCCCCCCCCCCCull, kX4 = 0xF0F0F0F0F0F0F0F0ull;
 constexpr std::uint64_t kY1 = 0xFF00FF00FF00FF00ull, kY2 = 0xFFFF0000FFFF0000ull, kY4 = 0xFFFFFFFF00000000ull;
 
-// The centroid of a non-empty mask's samples, in samples from the pixel's low corner (sample
-// centres at +0.5).
-glm::vec2 centroid(std::uint64_t m, int count) {
-  const int sx = popcount(m & kX1) + 2 * popcount(m & kX2) + 4 * popcount(m & kX4);
-  const int sy = popcount(m & kY1) + 2 * popcount(m & kY2) + 4 * popcount(m & kY4);
+// A non-empty mask's samples: how many, and their centroid in samples from the pixel's low
+// corner (sample centres at +0.5). Seven population counts: with the CPU's instruction where it
+// has one (every x86-64 since 2008; the build targets the baseline without it), which took the
+// tiler's and pyramid's instructions for an 8 x 8 frame over N44W072 down by 4-5% (callgrind).
+struct Samples {
+  int count;
+  glm::vec2 centroid;
+};
+template <typename Count>
+[[gnu::always_inline]] inline Samples samples_with(std::uint64_t m, Count pc) {
+  const int count = pc(m);
   const float inv = 1.0f / static_cast<float>(count);
-  return {static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f};
+  const int sx = pc(m & kX1) + 2 * pc(m & kX2) + 4 * pc(m & kX4);
+  const int sy = pc(m & kY1) + 2 * pc(m & kY2) + 4 * pc(m & kY4);
+  return {count, {static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f}};
 }
+Samples samples_swar(std::uint64_t m) { return samples_with(m, popcount); }
+#if defined(__x86_64__) && defined(__GNUC__)
+[[gnu::target("popcnt")]] Samples samples_popcnt(std::uint64_t m) {
+  return samples_with(m, [](std::uint64_t x) { return __builtin_popcountll(x); });
+}
+bool has_popcnt() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("popcnt") != 0;
+  }();
+  return yes;
+}
+Samples samples(std::uint64_t m) { return has_popcnt() ? samples_popcnt(m) : samples_swar(m); }
+#else
+Samples samples(std::uint64_t m) { return samples_swar(m); }
+#endif
 
 int pow2_at_least(double v, int cap) {
   int k = 1;
@@ -742,8 +766,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             for (int bx = 0; bx < sh.kx; ++bx) {
               const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
               if (!part) continue;
-              const int pc = popcount(part);
-              const glm::vec2 pq = centroid(part, pc);
+              const auto [pc, pq] = samples(part);
               ++st.stats.shading_points;
               out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
             }
@@ -766,9 +789,9 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             const std::uint64_t sub = (rec.mask >> shift) & full;
             if (!sub) continue;
             const bool whole = sub == full;
-            const int c = whole ? N : popcount(sub);
+            const Samples at = whole ? Samples{N, centre} : samples(sub);
             const std::uint64_t covered = sh.translucent ? (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full : 0;
-            fragment(rec.tx * per_tile + i, rec.ty * per_tile + j, sub, c, whole ? centre : centroid(sub, c), covered);
+            fragment(rec.tx * per_tile + i, rec.ty * per_tile + j, sub, at.count, at.centroid, covered);
           }
         }
       }
@@ -790,8 +813,9 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             if (!sub) continue;
             const int px = tx * per_tile + i, py = ty * per_tile + j;
             const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
-            const int c = sub == full ? N : popcount(sub);
-            const float qy = sub == full ? 0.5f * aa : centroid(sub, c).y;
+            const Samples at = sub == full ? Samples{N, glm::vec2(0.5f * aa)} : samples(sub);
+            const int c = at.count;
+            const float qy = at.centroid.y;
             const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;
             out.add(p, sub, c, bottom + (top - bottom) * f, 1.0f);
             out.px[p].count += static_cast<std::uint32_t>(c);
