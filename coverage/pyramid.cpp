@@ -78,7 +78,8 @@ constexpr std::uint64_t rect_mask(int i0, int i1, int j0, int j1) {
 }
 
 // The 8x8 lattice masks of an edge function: bit 8 j + i is set where v + i sa + j sb >= 0,
-// i, j in [0, 8). Word-wide: one SIMD add and one sign extraction per 2 or 4 lattice points.
+// i, j in [0, 8). Word-wide: one SIMD add per 2 or 4 lattice points, and the signs of two rows
+// (16 points) packed to bytes and taken by one movemask.
 // mask64: every value must fit in 63 bits (|v| + 7 |sa| + 7 |sb| < 2^62).
 [[gnu::always_inline]] inline std::uint64_t mask64(i64 v, i64 sa, i64 sb) {
 #if TERRAVOL_COVERAGE_SIMD
