@@ -228,11 +228,6 @@ struct Color {
   friend Color operator-(Color a, Color b) { return Color(_mm_sub_ps(a.v, b.v)); }
   friend Color operator*(Color a, float s) { return Color(_mm_mul_ps(a.v, _mm_set1_ps(s))); }
   Color& operator+=(Color b) { return *this = *this + b; }
-  std::array<float, 4> lanes() const {
-    std::array<float, 4> f;
-    _mm_storeu_ps(f.data(), v);
-    return f;
-  }
   // The RGBA bytes at p, as floats.
   static Color bytes(const std::uint8_t* p) {
     std::int32_t word;
@@ -240,6 +235,13 @@ struct Color {
     const __m128i zero = _mm_setzero_si128();
     const __m128i x = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
     return Color(_mm_cvtepi32_ps(x));
+  }
+  // r, g, b rounded half up and clamped to 0..255, as three bytes at out.
+  void store_rgb(std::uint8_t* out) const {
+    const __m128 r = _mm_min_ps(_mm_max_ps(_mm_add_ps(v, _mm_set1_ps(0.5f)), _mm_setzero_ps()), _mm_set1_ps(255.0f));
+    const __m128i w = _mm_cvttps_epi32(r);
+    const std::int32_t word = _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(w, w), w));
+    std::memcpy(out, &word, 3);  // little-endian: r, g, b first
   }
 };
 #else
@@ -260,8 +262,10 @@ struct Color {
     return a;
   }
   Color& operator+=(Color b) { return *this = *this + b; }
-  std::array<float, 4> lanes() const { return c; }
   static Color bytes(const std::uint8_t* p) { return Color(p[0], p[1], p[2]); }
+  void store_rgb(std::uint8_t* out) const {
+    for (std::size_t k = 0; k < 3; ++k) out[k] = static_cast<std::uint8_t>(std::clamp(c[k] + 0.5f, 0.0f, 255.0f));
+  }
 };
 #endif
 
@@ -783,6 +787,13 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
           }
           continue;
         }
+        if (per_tile == 1) {  // aa = 8: the tile is one pixel, its mask the pixel's samples
+          const std::uint64_t sub = rec.mask;
+          if (!sub) continue;
+          const Samples at = sub == full ? Samples{N, centre} : samples(sub);
+          fragment(rec.tx, rec.ty, sub, at.count, at.centroid, sh.translucent ? pyramid.tile_bits(rec.tx, rec.ty) : 0);
+          continue;
+        }
         for (int j = 0; j < per_tile; ++j) {
           for (int i = 0; i < per_tile; ++i) {
             const int shift = 8 * j * aa + i * aa;
@@ -829,8 +840,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       const std::size_t src = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
       const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
       for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
-        const std::array<float, 4> v = (out.px[src + x].acc * scale).lanes();
-        for (std::size_t k = 0; k < 3; ++k) rgb_[3 * (dst + x) + k] = static_cast<std::uint8_t>(std::clamp(v[k] + 0.5f, 0.0f, 255.0f));
+        (out.px[src + x].acc * scale).store_rgb(&rgb_[3 * (dst + x)]);
         counts_[dst + x] = static_cast<std::uint8_t>(std::min<std::uint32_t>(out.px[src + x].count, 255));
       }
     }
