@@ -490,10 +490,25 @@ void Pyramid::cover_cell(int level, int cx, int cy, const Edges& E, const std::u
       m.v &= ~w;
       stats_.pixels_claimed += static_cast<std::uint64_t>(detail::popcount64(w)) * static_cast<std::uint64_t>(s * s);
     }
-    for (std::uint64_t bits = w; bits; bits &= bits - 1) {
-      const int bit = std::countr_zero(bits);
-      if (claim_) fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
-      if (record_) report_subtree(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+    if (level == 1 && record_) {
+      // Tiles: each row's runs of newly covered tiles reported as one record each.
+      for (int j = 0; j < 8; ++j) {
+        for (unsigned row = static_cast<unsigned>(w >> (8 * j)) & 0xFFu; row;) {
+          const int i0 = std::countr_zero(row);
+          const int len = std::countr_one(row >> i0);
+          record_->push_back({8 * cx + i0, 8 * cy + j, kAll, len});
+          row &= ~(((1u << len) - 1u) << i0);
+        }
+      }
+      if (claim_) {
+        for (std::uint64_t bits = w; bits; bits &= bits - 1) fill(0, 8 * cx + (std::countr_zero(bits) & 7), 8 * cy + (std::countr_zero(bits) >> 3));
+      }
+    } else {
+      for (std::uint64_t bits = w; bits; bits &= bits - 1) {
+        const int bit = std::countr_zero(bits);
+        if (claim_) fill(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+        if (record_) report_subtree(level - 1, 8 * cx + (bit & 7), 8 * cy + (bit >> 3));
+      }
     }
   }
   for (std::uint64_t active = ~(w | pv | m.c); active; active &= active - 1) {
