@@ -31,7 +31,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version as CLI11 prints them; a bad command line in one line, status 1.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::fprintf(stderr, "terravol: %s\n", e.what());
+    return 1;
   } catch (const terravol::app::cli::QuietFailure&) {
     return 1;  // another MPI rank printed why
   } catch (const terravol::io::FormatError& e) {

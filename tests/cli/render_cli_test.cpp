@@ -259,6 +259,8 @@ void expect_clean_failure(const std::string& args, const std::string& must_menti
 TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   const std::string dem = bundled_dem();
   expect_clean_failure(dem + " --camera 45.5,6.5,3000", "--camera");
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --near-plane abc", "--near-plane");  // CLI11's own check
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --no-such-option", "--no-such-option");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,north,-10", "--camera");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-100", "pitch");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --size 0x0", "--size");

@@ -201,6 +201,7 @@ TEST(TilerCli, BadRendererAndAaValuesFailWithOneLine) {
       {" --renderer tiler --texel-rate -1", "--texel-rate"},
       {" --renderer tiler --texel-rate inf", "--texel-rate"},
       {" --renderer tiler --texel-rate nan", "--texel-rate"},
+      {" --renderer tiler --texel-rate fine", "--texel-rate"},
       {" --texel-rate 1", "--texel-rate"},
   };
   for (const auto& [args, names] : cases) {
