@@ -100,6 +100,7 @@ IsolatedRun run_isolated(const std::function<std::string()>& work, std::size_t e
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  run.timed_out = timed_out;
   if (timed_out) {
     char b[64];
     std::snprintf(b, sizeof b, "took longer than %.0f s", timeout_seconds);
@@ -119,7 +120,7 @@ Volume parse_isolated(std::string_view bytes, const std::string& source, const s
   const double timeout = 30.0 + static_cast<double>(bytes.size()) / 20e6;
   const std::size_t memory = (std::size_t{3} << 30) + 4 * bytes.size();
   // The child's answer: 'V' + a serialised volume, or 'E' + source + NUL + problem.
-  const IsolatedRun run = run_isolated(
+  const std::function<std::string()> work =
       [&]() -> std::string {
         try {
           return "V" + serialize_volume(parse());
@@ -133,8 +134,9 @@ Volume parse_isolated(std::string_view bytes, const std::string& source, const s
         } catch (...) {
           return "E" + source + '\0' + "corrupt " + format + " file";
         }
-      },
-      memory, timeout);
+      };
+  IsolatedRun run = run_isolated(work, memory, timeout);
+  if (run.timed_out) run = run_isolated(work, memory, timeout);  // (see the header)
   if (!run.ok) throw io::FormatError(source, "corrupt " + format + " file (the " + format + " reader " + run.failure + ")");
   if (run.output.empty()) throw io::FormatError(source, "corrupt " + format + " file (no answer from the reader)");
   if (run.output[0] == 'E') {
