@@ -228,14 +228,9 @@ struct Color {
   friend Color operator-(Color a, Color b) { return Color(_mm_sub_ps(a.v, b.v)); }
   friend Color operator*(Color a, float s) { return Color(_mm_mul_ps(a.v, _mm_set1_ps(s))); }
   Color& operator+=(Color b) { return *this = *this + b; }
-  // The RGBA bytes at p, as floats.
-  static Color bytes(const std::uint8_t* p) {
-    std::int32_t word;
-    std::memcpy(&word, p, 4);
-    const __m128i zero = _mm_setzero_si128();
-    const __m128i x = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero), zero);
-    return Color(_mm_cvtepi32_ps(x));
-  }
+  // (0, 0, 0, x): the fourth lane is free for a count (Pixel).
+  static Color fourth(float x) { return Color(_mm_set_ps(x, 0.0f, 0.0f, 0.0f)); }
+  float get_fourth() const { return _mm_cvtss_f32(_mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 3, 3))); }
   // r, g, b rounded half up and clamped to 0..255, as three bytes at out.
   void store_rgb(std::uint8_t* out) const {
     const __m128 r = _mm_min_ps(_mm_max_ps(_mm_add_ps(v, _mm_set1_ps(0.5f)), _mm_setzero_ps()), _mm_set1_ps(255.0f));
@@ -262,7 +257,12 @@ struct Color {
     return a;
   }
   Color& operator+=(Color b) { return *this = *this + b; }
-  static Color bytes(const std::uint8_t* p) { return Color(p[0], p[1], p[2]); }
+  static Color fourth(float x) {
+    Color c;
+    c.c[3] = x;
+    return c;
+  }
+  float get_fourth() const { return c[3]; }
   void store_rgb(std::uint8_t* out) const {
     for (std::size_t k = 0; k < 3; ++k) out[k] = static_cast<std::uint8_t>(std::clamp(c[k] + 0.5f, 0.0f, 255.0f));
   }
@@ -291,58 +291,110 @@ struct Shade {
   std::array<Plane, 5> n;    // textured: u, v (texels), haze; wall: haze; merged: r, g, b, a (0..255), haze
 };
 
+// Four floats or ints, one per shading point, in GCC's vector extension: one SSE2 register each
+// on x86-64, plain arithmetic elsewhere. The shader runs on four points of one triangle at once
+// (the same operations in the same order as one point at a time, so the images are the same
+// bytes); hand-written because VTK and the libraries here shade on the GPU, not per fragment in
+// software.
+using F4 = float __attribute__((vector_size(16)));
+using I4 = std::int32_t __attribute__((vector_size(16)));
+
+F4 eval(const Plane& p, F4 dx, F4 dy) { return p.at + p.a * dx + p.b * dy; }
+
+// The colour (0..255) and opacity of a triangle at four window points (x[k], y[k]).
+struct Shaded4 {
+  std::array<Color, 4> color;
+  std::array<float, 4> alpha;
+};
+
 // The lattice texture: bilinear between texel centres (whole texel coordinates), clamped to the
 // edge (GL's LINEAR filter with CLAMP_TO_EDGE).
 struct Texture {
   const std::uint8_t* rgba = nullptr;
   int side = 0;
-  Color at(float u, float v) const {
-    const float hi = static_cast<float>(side - 1);
-    u = std::clamp(u, 0.0f, hi);
-    v = std::clamp(v, 0.0f, hi);
-    const int i0 = std::min(static_cast<int>(u), std::max(side - 2, 0));
-    const int j0 = std::min(static_cast<int>(v), std::max(side - 2, 0));
-    const float fu = u - static_cast<float>(i0), fv = v - static_cast<float>(j0);
+  // Channels r, g, b at the four points (u[k], v[k]).
+  void at(F4 u, F4 v, F4& r, F4& g, F4& b) const {
+    const float hi = static_cast<float>(side - 1), lim = static_cast<float>(std::max(side - 2, 0));
+    u = u > 0.0f ? u : 0.0f;  // (NaN goes to 0)
+    v = v > 0.0f ? v : 0.0f;
+    u = u < hi ? u : hi;
+    v = v < hi ? v : hi;
+    F4 i0 = __builtin_convertvector(__builtin_convertvector(u, I4), F4);  // floor: u >= 0
+    F4 j0 = __builtin_convertvector(__builtin_convertvector(v, I4), F4);
+    i0 = i0 < lim ? i0 : lim;
+    j0 = j0 < lim ? j0 : lim;
+    const F4 fu = u - i0, fv = v - j0;
+    const I4 i = __builtin_convertvector(i0, I4), j = __builtin_convertvector(j0, I4);
     const std::size_t step = side > 1 ? 4 : 0, row = step * static_cast<std::size_t>(side);
-    const std::uint8_t* p = rgba + 4 * (static_cast<std::size_t>(j0) * static_cast<std::size_t>(side) + static_cast<std::size_t>(i0));
-    const Color c00 = Color::bytes(p), c10 = Color::bytes(p + step);
-    const Color c01 = Color::bytes(p + row), c11 = Color::bytes(p + row + step);
-    const Color b = c00 + (c10 - c00) * fu, t = c01 + (c11 - c01) * fu;
-    return b + (t - b) * fv;
+    I4 w00, w10, w01, w11;
+    for (int k = 0; k < 4; ++k) {
+      const std::uint8_t* p = rgba + 4 * (static_cast<std::size_t>(j[k]) * static_cast<std::size_t>(side) + static_cast<std::size_t>(i[k]));
+      std::int32_t w[4];
+      std::memcpy(&w[0], p, 4);
+      std::memcpy(&w[1], p + step, 4);
+      std::memcpy(&w[2], p + row, 4);
+      std::memcpy(&w[3], p + row + step, 4);
+      w00[k] = w[0];
+      w10[k] = w[1];
+      w01[k] = w[2];
+      w11[k] = w[3];
+    }
+    const auto channel = [&](int shift) {
+      const auto c = [&](I4 w) { return __builtin_convertvector((w >> shift) & 0xFF, F4); };  // little-endian
+      const F4 c00 = c(w00), c10 = c(w10), c01 = c(w01), c11 = c(w11);
+      const F4 bottom = c00 + (c10 - c00) * fu, top = c01 + (c11 - c01) * fu;
+      return bottom + (top - bottom) * fv;
+    };
+    r = channel(0);
+    g = channel(8);
+    b = channel(16);
   }
 };
 
-// The colour (0..255) and opacity of a triangle at window point (x, y).
 struct Shader {
   Texture texture;
-  Color wall;
-  Color haze;
+  std::array<float, 3> wall_rgb{};
+  std::array<float, 3> haze{};
   bool hazy = false;
-  Color operator()(const Shade& sh, float x, float y, float& alpha) const {
-    const float dx = x - sh.x0, dy = y - sh.y0;
-    float S = sh.s(dx, dy);
-    if (!(S != 0.0f) || !std::isfinite(S)) S = 1.0f;  // a triangle seen edge-on: any point of it
-    const float inv = 1.0f / S;
-    Color c;
-    float h = 0;
-    alpha = 1.0f;
+  Shaded4 operator()(const Shade& sh, const float* x, const float* y) const {
+    const F4 dx = F4{x[0], x[1], x[2], x[3]} - sh.x0, dy = F4{y[0], y[1], y[2], y[3]} - sh.y0;
+    F4 S = eval(sh.s, dx, dy);
+    const F4 mag = S < 0.0f ? -S : S;
+    S = (S == 0.0f) | ~(mag < std::numeric_limits<float>::infinity()) ? F4{1.0f, 1.0f, 1.0f, 1.0f} : S;  // edge-on: any point of it
+    const F4 inv = 1.0f / S;
+    F4 r{}, g{}, b{}, h{}, alpha = {1.0f, 1.0f, 1.0f, 1.0f};
     switch (sh.kind) {
       case Kind::kTextured:
-        c = texture.at(sh.n[0](dx, dy) * inv, sh.n[1](dx, dy) * inv);
-        h = sh.n[2](dx, dy) * inv;
+        texture.at(eval(sh.n[0], dx, dy) * inv, eval(sh.n[1], dx, dy) * inv, r, g, b);
+        h = eval(sh.n[2], dx, dy) * inv;
         break;
       case Kind::kWall:
-        c = wall;
-        h = sh.n[0](dx, dy) * inv;
+        r = F4{} + wall_rgb[0];
+        g = F4{} + wall_rgb[1];
+        b = F4{} + wall_rgb[2];
+        h = eval(sh.n[0], dx, dy) * inv;
         break;
       case Kind::kMerged:
-        c = Color(sh.n[0](dx, dy), sh.n[1](dx, dy), sh.n[2](dx, dy)) * inv;
-        alpha = std::clamp(sh.n[3](dx, dy) * inv * (1.0f / 255.0f), 0.0f, 1.0f);
-        h = sh.n[4](dx, dy) * inv;
+        r = eval(sh.n[0], dx, dy) * inv;
+        g = eval(sh.n[1], dx, dy) * inv;
+        b = eval(sh.n[2], dx, dy) * inv;
+        alpha = eval(sh.n[3], dx, dy) * inv * (1.0f / 255.0f);
+        alpha = alpha > 0.0f ? alpha : 0.0f;
+        alpha = alpha < 1.0f ? alpha : 1.0f;
+        h = eval(sh.n[4], dx, dy) * inv;
         break;
     }
-    if (hazy) c += (haze - c) * h;
-    return c;
+    if (hazy) {
+      r += (haze[0] - r) * h;
+      g += (haze[1] - g) * h;
+      b += (haze[2] - b) * h;
+    }
+    Shaded4 out;
+    for (int k = 0; k < 4; ++k) {
+      out.color[static_cast<std::size_t>(k)] = Color(r[k], g[k], b[k]);
+      out.alpha[static_cast<std::size_t>(k)] = alpha[k];
+    }
+    return out;
   }
 };
 
@@ -352,19 +404,39 @@ struct Class {
   std::int32_t next;
 };
 
-// What a pixel accumulates (one 32-byte record, so that a fragment touches one cache line): the
-// colour summed over its samples (0..255 each), the transmittance of its open samples when it is
-// uniform, else the head of its transmittance classes (-1: uniform), the samples shaded.
-struct alignas(32) Pixel {
+// What a pixel accumulates, in one 16-byte record: the colour summed over its samples (0..255
+// each) in r, g, b, and the samples shaded in the fourth lane (whole numbers, exact in a float).
+// Half the 32 bytes that held the transmittance too: the records are the tiler's largest
+// working set, a band's worth per thread.
+struct Pixel {
   Color acc;
+};
+
+// The transmittance of a pixel's open samples when it is uniform, else the head of its
+// transmittance classes (-1: uniform). Kept once a band has met a translucent triangle: before
+// that (front to back) every pixel's is 1, uniform.
+struct Transmittance {
   float t = 1.0f;
   std::int32_t head = -1;
-  std::uint32_t count = 0;
 };
 
 }  // namespace
 
 struct Renderer::Impl {
+  // Shading points of one triangle waiting to be shaded four at a time: pixel p's samples mask
+  // (count of them; covered: the pixel's covered samples, for translucent triangles) at window
+  // point (x, y).
+  struct Point {
+    std::size_t p;
+    std::uint64_t mask, covered;
+    int count;
+  };
+  struct Queue {
+    std::array<Point, 4> points;
+    alignas(16) float x[4];
+    alignas(16) float y[4];
+    int n = 0;
+  };
   // Per band and thread: the band's pyramid (one per band height: the last band may be
   // shorter), the pyramid's reports, transmittance classes, polygon scratch, counters.
   struct BandState {
@@ -372,7 +444,9 @@ struct Renderer::Impl {
     std::vector<coverage::TileMask> records;
     std::vector<Class> classes;
     std::vector<Pixel> pixels;  // the band's, rows from its first (bottom) one
+    std::vector<Transmittance> transmittance;  // the band's pixels', once it has met translucency
     std::vector<glm::dvec2> poly;
+    Queue queue;
     Stats stats;
     coverage::Pyramid& pyramid(int w, int h) {
       for (auto& p : pyramids)
@@ -396,18 +470,24 @@ namespace {
 // pixels of one band (rows from the bottom), and its transmittance classes.
 struct Accumulator {
   Pixel* px;
+  std::size_t n_pixels;
+  std::vector<Transmittance>& tr;  // empty until the band's first translucent fragment
   std::vector<Class>& classes;
   Stats& stats;
   std::uint64_t full;  // a pixel's samples
+
+  // Counts count samples shaded in pixel p.
+  void shaded(std::size_t p, int count) { px[p].acc += Color::fourth(static_cast<float>(count)); }
 
   // Adds colour c times weight to pixel p for the samples of mask (all open), each weighted by
   // its transmittance.
   void add(std::size_t p, std::uint64_t mask, int count, Color c, float weight) {
     float w = 0;
-    Pixel& q = px[p];
-    const std::int32_t h0 = q.head;
-    if (h0 < 0) {
-      w = static_cast<float>(count) * q.t;
+    const std::int32_t h0 = tr.empty() ? -1 : tr[p].head;
+    if (tr.empty()) {
+      w = static_cast<float>(count);
+    } else if (h0 < 0) {
+      w = static_cast<float>(count) * tr[p].t;
     } else {
       for (std::int32_t k = h0; k >= 0; k = classes[static_cast<std::size_t>(k)].next) {
         const Class& cl = classes[static_cast<std::size_t>(k)];
@@ -415,29 +495,23 @@ struct Accumulator {
         if (i) w += static_cast<float>(popcount(i)) * cl.t;
       }
     }
-    q.acc += c * (w * weight);
-  }
-
-  // An opaque fragment's newly covered samples: shaded once or block by block.
-  void opaque(std::size_t p, std::uint64_t mask, int count, Color c) {
-    px[p].count += static_cast<std::uint32_t>(count);
-    stats.samples_covered += static_cast<std::uint64_t>(count);
-    add(p, mask, count, c, 1.0f);
+    px[p].acc += c * (w * weight);
   }
 
   // A translucent fragment: colour c with opacity alpha over the samples of mask (all open);
   // the pixel's covered samples are `covered`.
   void translucent(std::size_t p, std::uint64_t mask, int count, std::uint64_t covered, Color c, float alpha) {
     add(p, mask, count, c, alpha);
+    if (tr.empty()) tr.assign(n_pixels, Transmittance());
     const float keep = 1.0f - alpha;
-    std::int32_t& h0 = px[p].head;
+    std::int32_t& h0 = tr[p].head;
     if (h0 < 0) {
       const std::uint64_t rest = full & ~mask & ~covered;
       if (!rest) {
-        px[p].t *= keep;
+        tr[p].t *= keep;
         return;
       }
-      const float t = px[p].t;
+      const float t = tr[p].t;
       classes.push_back({rest, t, -1});
       classes.push_back({mask, t * keep, static_cast<std::int32_t>(classes.size()) - 1});
       h0 = static_cast<std::int32_t>(classes.size()) - 1;
@@ -488,7 +562,7 @@ struct Accumulator {
     }
     // (mask is open and not empty, so some class is left.)
     if (classes[static_cast<std::size_t>(h0)].next < 0) {
-      px[p].t = classes[static_cast<std::size_t>(h0)].t;
+      tr[p].t = classes[static_cast<std::size_t>(h0)].t;
       h0 = -1;
     }
   }
@@ -703,8 +777,8 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   const float inv_aa = 1.0f / static_cast<float>(aa);
   Shader shader;
   shader.texture = {colors.texture.data(), static_cast<int>(side)};
-  shader.wall = Color(colors.wall_color.r, colors.wall_color.g, colors.wall_color.b);
-  shader.haze = Color(static_cast<float>(look.haze_color.r), static_cast<float>(look.haze_color.g), static_cast<float>(look.haze_color.b));
+  shader.wall_rgb = {static_cast<float>(colors.wall_color.r), static_cast<float>(colors.wall_color.g), static_cast<float>(colors.wall_color.b)};
+  shader.haze = {static_cast<float>(look.haze_color.r), static_cast<float>(look.haze_color.g), static_cast<float>(look.haze_color.b)};
   shader.hazy = look.haze_distance > 0.0;
 
   // One band: its triangles tiled into its own pyramid, front to back, then the sky.
@@ -716,9 +790,9 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     st.classes.clear();
     const std::size_t count = static_cast<std::size_t>(rows) * static_cast<std::size_t>(W);
     st.pixels.assign(count, Pixel());
+    st.transmittance.clear();
     // Pixel p of the band: (x, y) with y counted from the band's first row.
-    Accumulator out{st.pixels.data(),
-                    st.classes, st.stats, full};
+    Accumulator out{st.pixels.data(), count, st.transmittance, st.classes, st.stats, full};
 
     std::array<glm::dvec2, kMaxClipped> poly;
     for (std::size_t item = m.band_start[static_cast<std::size_t>(band)]; item < m.band_start[static_cast<std::size_t>(band) + 1]; ++item) {
@@ -744,36 +818,56 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       }
       ++st.stats.tiled;
 
-      // The fragments: per pixel of each reported tile, its newly covered (or shown) samples.
+      // The fragments: per pixel of each reported tile, its newly covered (or shown) samples,
+      // shaded in fours (st.queue), each point added to its pixel in the order it came.
       const bool blocks = sh.kx > 1 || sh.ky > 1;
       const float y_base = static_cast<float>(row0);
+      Impl::Queue& queue = st.queue;
+      const auto flush = [&] {
+        for (int k = queue.n; k < 4; ++k) {  // (the lanes left over shade the first point again)
+          queue.x[k] = queue.x[0];
+          queue.y[k] = queue.y[0];
+        }
+        const Shaded4 shaded = shader(sh, queue.x, queue.y);
+        for (std::size_t k = 0; k < static_cast<std::size_t>(queue.n); ++k) {
+          const Impl::Point& q = queue.points[k];
+          if (sh.translucent) {
+            out.translucent(q.p, q.mask, q.count, q.covered, shaded.color[k], shaded.alpha[k]);
+          } else {
+            out.add(q.p, q.mask, q.count, shaded.color[k], 1.0f);
+          }
+        }
+        queue.n = 0;
+      };
+      // A shading point: samples mask (count of them) of pixel p, shaded at window point (x, y).
+      const auto shade = [&](std::size_t p, std::uint64_t mask, int samples_in, float x, float y, std::uint64_t covered) {
+        ++st.stats.shading_points;
+        queue.points[static_cast<std::size_t>(queue.n)] = {p, mask, covered, samples_in};
+        queue.x[queue.n] = x;
+        queue.y[queue.n] = y;
+        if (++queue.n == 4) flush();
+      };
       // Pixel (px, py) of the band, its samples sub (count c, centroid q in samples), the pixel's
       // covered samples (translucent triangles only).
       const auto fragment = [&](int px, int py, std::uint64_t sub, int c, glm::vec2 q, std::uint64_t covered) {
         const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
         ++st.stats.fragments;
-        const float x = static_cast<float>(px) + q.x * inv_aa, y = y_base + static_cast<float>(py) + q.y * inv_aa;
-        float alpha = 1.0f;
-        if (sh.translucent) {
-          ++st.stats.shading_points;
-          const Color col = shader(sh, x, y, alpha);
-          out.translucent(p, sub, c, covered, col, alpha);
-        } else if (!blocks) {
-          ++st.stats.shading_points;
-          out.opaque(p, sub, c, shader(sh, x, y, alpha));
-        } else {
-          // Block by block: each block's samples shaded at their centroid.
-          out.px[p].count += static_cast<std::uint32_t>(c);
+        if (!sh.translucent) {
+          out.shaded(p, c);
           st.stats.samples_covered += static_cast<std::uint64_t>(c);
-          const int bw = aa / sh.kx, bh = aa / sh.ky;
-          for (int by = 0; by < sh.ky; ++by) {
-            for (int bx = 0; bx < sh.kx; ++bx) {
-              const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
-              if (!part) continue;
-              const auto [pc, pq] = samples(part);
-              ++st.stats.shading_points;
-              out.add(p, part, pc, shader(sh, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, alpha), 1.0f);
-            }
+        }
+        if (sh.translucent || !blocks) {
+          shade(p, sub, c, static_cast<float>(px) + q.x * inv_aa, y_base + static_cast<float>(py) + q.y * inv_aa, covered);
+          return;
+        }
+        // Block by block: each block's samples shaded at their centroid.
+        const int bw = aa / sh.kx, bh = aa / sh.ky;
+        for (int by = 0; by < sh.ky; ++by) {
+          for (int bx = 0; bx < sh.kx; ++bx) {
+            const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
+            if (!part) continue;
+            const auto [pc, pq] = samples(part);
+            shade(p, part, pc, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, 0);
           }
         }
       };
@@ -806,6 +900,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
           }
         }
       }
+      if (queue.n > 0) flush();
     }
 
     // The sky over every sample still vacant (section 4.5: "composite a screen-sized polygon of
@@ -829,7 +924,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             const float qy = at.centroid.y;
             const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;
             out.add(p, sub, c, bottom + (top - bottom) * f, 1.0f);
-            out.px[p].count += static_cast<std::uint32_t>(c);
+            out.shaded(p, c);
             st.stats.samples_background += static_cast<std::uint64_t>(c);
           }
         }
@@ -840,8 +935,9 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       const std::size_t src = static_cast<std::size_t>(y) * static_cast<std::size_t>(W);
       const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
       for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
-        (out.px[src + x].acc * scale).store_rgb(&rgb_[3 * (dst + x)]);
-        counts_[dst + x] = static_cast<std::uint8_t>(std::min<std::uint32_t>(out.px[src + x].count, 255));
+        const Color acc = out.px[src + x].acc;
+        (acc * scale).store_rgb(&rgb_[3 * (dst + x)]);
+        counts_[dst + x] = static_cast<std::uint8_t>(std::min(acc.get_fourth(), 255.0f));
       }
     }
     st.stats.cells_visited += pyramid.stats().cells_visited;
