@@ -444,6 +444,7 @@ struct Renderer::Impl {
     std::vector<coverage::TileMask> records;
     std::vector<Class> classes;
     std::vector<Pixel> pixels;  // the band's, rows from its first (bottom) one
+    bool pixels_dirty = false;  // pixels not all zero: a band was left unfinished
     std::vector<Transmittance> transmittance;  // the band's pixels', once it has met translucency
     std::vector<glm::dvec2> poly;
     Queue queue;
@@ -789,7 +790,14 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
     coverage::Pyramid& pyramid = st.pyramid(W * aa, rows * aa);
     st.classes.clear();
     const std::size_t count = static_cast<std::size_t>(rows) * static_cast<std::size_t>(W);
-    st.pixels.assign(count, Pixel());
+    // The records are zero between bands: the last pass below clears each as it reads it, while
+    // it is in the cache, instead of a pass of its own here (unless a band was left unfinished).
+    if (st.pixels_dirty) {
+      st.pixels.assign(count, Pixel());
+    } else if (st.pixels.size() < count) {
+      st.pixels.resize(count);
+    }
+    st.pixels_dirty = true;
     st.transmittance.clear();
     // Pixel p of the band: (x, y) with y counted from the band's first row.
     Accumulator out{st.pixels.data(), count, st.transmittance, st.classes, st.stats, full};
@@ -936,10 +944,12 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
       const std::size_t dst = static_cast<std::size_t>(H - 1 - row0 - y) * static_cast<std::size_t>(W);
       for (std::size_t x = 0; x < static_cast<std::size_t>(W); ++x) {
         const Color acc = out.px[src + x].acc;
+        out.px[src + x].acc = Color();
         (acc * scale).store_rgb(&rgb_[3 * (dst + x)]);
         counts_[dst + x] = static_cast<std::uint8_t>(std::min(acc.get_fourth(), 255.0f));
       }
     }
+    st.pixels_dirty = false;
     st.stats.cells_visited += pyramid.stats().cells_visited;
     st.stats.tile_cpu_ms += thread_cpu_ms() - cpu0;
   };
