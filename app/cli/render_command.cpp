@@ -142,7 +142,7 @@ void run_render(const RenderOptions& o) {
   }
   if (!o.export_vtp.empty()) {
     render::TerrainRenderer& r = view.renderer();
-    output::export_vtp(o.export_vtp, r.scene(), r.camera(), r.settings(), o.force);
+    output::export_vtp(o.export_vtp, r.scene(), view.terrain().tree().cells(), r.camera(), r.settings(), o.force);
     std::printf("wrote %s\n", o.export_vtp.string().c_str());
   }
   if (!o.stats.empty()) {

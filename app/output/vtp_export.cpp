@@ -23,6 +23,10 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
+#include "app/scene/terrain_colors.h"
+
 namespace terravol::app::output {
 
 namespace {
@@ -46,7 +50,7 @@ void add_rgb(vtkFieldData* fd, const char* name, const scene::Rgb& c) {
 
 }  // namespace
 
-void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, vtkCamera* camera,
+void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, int lattice_cells, vtkCamera* camera,
                 const render::RenderSettings& settings, bool overwrite) {
   if (!overwrite && std::filesystem::exists(path)) {
     throw std::runtime_error(path.string() + ": exists (use --force to overwrite)");
@@ -82,16 +86,38 @@ void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, vtkCamera
   polys->SetData(3, out_connectivity);
   out->SetPolys(polys);
 
-  for (const char* name : {"rgba", "normals"}) {
-    vtkDataArray* in = scene->GetPointData()->GetArray(name);
-    if (in == nullptr) continue;
+  if (vtkDataArray* in = scene->GetPointData()->GetArray("rgba")) {
     vtkSmartPointer<vtkDataArray> a = vtkSmartPointer<vtkDataArray>::Take(in->NewInstance());
-    a->SetName(name);
+    a->SetName("rgba");
     a->SetNumberOfComponents(in->GetNumberOfComponents());
     a->SetNumberOfTuples(ids->GetNumberOfIds());
     in->GetTuples(ids, a);
     out->GetPointData()->AddArray(a);
   }
+  // The normals, made here from the lattice's points (the renderer holds none).
+  const vtkIdType side = lattice_cells + 1, lattice = lattice_cells > 0 ? side * side : 0;
+  if (scene->GetNumberOfPoints() < lattice) {
+    throw std::invalid_argument("export_vtp: " + std::to_string(scene->GetNumberOfPoints()) + " points for a lattice of " +
+                                std::to_string(lattice_cells) + " cells");
+  }
+  vtkNew<vtkFloatArray> normals;
+  normals->SetName("normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(static_cast<vtkIdType>(old_id.size()));
+  vtkPoints* at = scene->GetPoints();
+  for (std::size_t k = 0; k < old_id.size(); ++k) {
+    const vtkIdType v = old_id[k];
+    glm::dvec3 n(0.0, 0.0, 1.0);
+    if (v < lattice) {
+      const auto point = [&](int i, int j) { return at->GetPoint(static_cast<vtkIdType>(j) * side + i); };
+      const int i = static_cast<int>(v % side), j = static_cast<int>(v / side);
+      n = scene::lattice_normal(
+          lattice_cells, i, j, [&](int ii) { return point(ii, j)[0]; }, [&](int jj) { return point(i, jj)[1]; },
+          [&](int ii, int jj) { return point(ii, jj)[2]; });
+    }
+    normals->SetTuple3(static_cast<vtkIdType>(k), n.x, n.y, n.z);
+  }
+  out->GetPointData()->SetNormals(normals);
   for (const char* name : {"level", "lod_rgba"}) {
     vtkDataArray* in = scene->GetCellData()->GetArray(name);
     if (in == nullptr || in->GetNumberOfTuples() != triangles) continue;

@@ -106,7 +106,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
                                  const RenderSettings& settings, const ColorTexture& texture)
     : settings_(settings), shade_(shading.shade), point_rgba_(shading.rgba) {
   const std::size_t n = positions.size();
-  if (shading.rgba.size() != n || shading.normals.size() != n || shading.shade.size() != n) {
+  if (shading.rgba.size() != n || shading.shade.size() != n) {
     throw std::invalid_argument("TerrainRenderer: " + std::to_string(n) + " positions but " +
                                 std::to_string(shading.rgba.size()) + " colours");
   }
@@ -120,13 +120,6 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   vtkNew<vtkPoints> points;
   points->SetData(xyz);
   poly_->SetPoints(points);
-
-  vtkNew<vtkFloatArray> normals;
-  normals->SetName("normals");
-  normals->SetNumberOfComponents(3);
-  normals->SetNumberOfTuples(count);
-  std::memcpy(normals->GetPointer(0), shading.normals.data(), n * sizeof(glm::vec3));
-  poly_->GetPointData()->SetNormals(normals);
 
   vtkNew<vtkUnsignedCharArray> rgba;
   rgba->SetName("rgba");
@@ -178,9 +171,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   actor_->ForceOpaqueOn();  // drawn in the opaque pass, in our order
   vtkProperty* property = actor_->GetProperty();
   property->LightingOff();  // the shading is baked into the colours (terrain_colors.h)
-  // VTK uploads point normals only for Gouraud and Phong interpolation, and no unlit shader
-  // reads them; flat keeps them off the GL buffers (the normals stay in the polydata for
-  // --export-vtp). Images byte-identical; a 4096-cell window's render 2.69 GB RSS -> 2.49 GB.
+  // Unlit, and the polydata has no normals (TerrainShading): flat, so that no shader asks for any.
   property->SetInterpolationToFlat();
   property->SetColor(1.0, 1.0, 1.0);
   if (settings.wireframe) property->SetRepresentationToWireframe();
@@ -302,15 +293,9 @@ void TerrainRenderer::reserve_tail(std::size_t capacity) {
     a->Modified();
   };
   vtkDataArray* xyz = poly_->GetPoints()->GetData();
-  for (vtkDataArray* a : {xyz, pd->GetNormals(), pd->GetScalars(), pd->GetTCoords()}) resize(a);
+  for (vtkDataArray* a : {xyz, pd->GetScalars(), pd->GetTCoords()}) resize(a);
   auto* p = static_cast<float*>(xyz->GetVoidPointer(0));
   std::fill(p + 3 * n, p + 3 * (n + capacity), 0.0f);
-  auto* nm = static_cast<float*>(pd->GetNormals()->GetVoidPointer(0));
-  for (std::size_t k = n; k < n + capacity; ++k) {
-    nm[3 * k] = 0.0f;
-    nm[3 * k + 1] = 0.0f;
-    nm[3 * k + 2] = 1.0f;
-  }
   auto* c = static_cast<unsigned char*>(pd->GetScalars()->GetVoidPointer(0));
   std::fill(c + 4 * n, c + 4 * (n + capacity), static_cast<unsigned char>(0));
   if (pd->GetTCoords() != nullptr) {
@@ -504,7 +489,7 @@ void TerrainRenderer::set_wireframe(bool on) {
 void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   const std::size_t n = positions.size();
-  if (shading.rgba.size() != n || shading.normals.size() != n || shading.shade.size() != n ||
+  if (shading.rgba.size() != n || shading.shade.size() != n ||
       texture.side != texture_side_ || (texture_side_ > 0 && shading.tcoords.size() != n) ||
       texture.rgba.size() != static_cast<std::size_t>(texture.side) * texture.side) {
     throw std::invalid_argument("TerrainRenderer::replace_vertices: " + std::to_string(n) +
@@ -525,7 +510,6 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   };
   copy(poly_->GetPoints()->GetData(), positions.data(), n * sizeof(glm::vec3));
   poly_->GetPoints()->Modified();
-  copy(poly_->GetPointData()->GetNormals(), shading.normals.data(), n * sizeof(glm::vec3));
   copy(poly_->GetPointData()->GetScalars(), shading.rgba.data(), n * sizeof(scene::Rgba));
   if (texture_side_ > 0) {
     copy(poly_->GetPointData()->GetTCoords(), shading.tcoords.data(), n * sizeof(glm::vec2));
@@ -556,8 +540,8 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   shade_.resize(shade_.size() + positions.size(), 1.0f);
   point_rgba_.insert(point_rgba_.end(), rgba.begin(), rgba.end());
   if (ordered != nullptr && !split_orders() && positions.size() <= tail_) {
-    // Into the reserved tail, whose placeholders already have a merged vertex's normal and
-    // texture coordinates: positions and colours written in place, and only they uploaded
+    // Into the reserved tail, whose placeholders already have a merged vertex's texture
+    // coordinates: positions and colours written in place, and only they uploaded
     // (update_vertices). Marking the arrays modified would make VTK upload every vertex again,
     // about 30 ms of the first frame after an edit of the benchmark's volumes over N44W072.
     write_vertices(static_cast<std::size_t>(old_count), positions, rgba.data());
@@ -577,8 +561,6 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
   };
   grow(poly_->GetPoints()->GetData(), positions.data(), sizeof(glm::vec3));
   poly_->GetPoints()->Modified();
-  const std::vector<glm::vec3> up(positions.size(), glm::vec3(0.0f, 0.0f, 1.0f));
-  grow(poly_->GetPointData()->GetNormals(), up.data(), sizeof(glm::vec3));
   grow(poly_->GetPointData()->GetScalars(), rgba.data(), sizeof(scene::Rgba));
   if (texture_side_ > 0) {
     const std::vector<glm::vec2> none(positions.size(), glm::vec2(-1.0f));
@@ -619,9 +601,9 @@ bool TerrainRenderer::replace_merged_vertices(std::span<const glm::vec3> positio
   }
   auto* xyz = static_cast<float*>(poly_->GetPoints()->GetData()->GetVoidPointer(0));
   if (std::memcmp(xyz, positions.data(), merged_base * sizeof(glm::vec3)) != 0) return false;
-  // The room after the terrain's vertices holds merged vertices or placeholders, whose normals
-  // (+z) and texture coordinates (-1, -1) are what merged vertices have: positions and colours
-  // are all that change.
+  // The room after the terrain's vertices holds merged vertices or placeholders, whose texture
+  // coordinates (-1, -1) are what merged vertices have: positions and colours are all that
+  // change.
   poly_->SetPolys(vtkNew<vtkCellArray>());
   poly_->GetCellData()->Initialize();
   point_rgba_.resize(n);
@@ -645,7 +627,7 @@ void TerrainRenderer::release_vertices() {
   poly_->GetCellData()->Initialize();
   if (split_orders()) merged_poly_->SetPolys(vtkNew<vtkCellArray>());
   vtkPointData* pd = poly_->GetPointData();
-  for (vtkDataArray* a : {poly_->GetPoints()->GetData(), pd->GetNormals(), pd->GetScalars(), pd->GetTCoords()}) {
+  for (vtkDataArray* a : {poly_->GetPoints()->GetData(), pd->GetScalars(), pd->GetTCoords()}) {
     if (a == nullptr) continue;
     a->Initialize();  // frees the storage (vtkDataArray::Squeeze would keep it at the count)
     a->Modified();

@@ -1,5 +1,5 @@
 // The VTK side of a terrain render: one vtkPolyData holding every vertex of the tree (positions,
-// normals, RGBA, uploaded once), whose triangle list is replaced by each traversal, drawn
+// RGBA, texture coordinates, uploaded once), whose triangle list is replaced by each traversal, drawn
 // either in tree order with no depth test (OrderedPolyDataMapper) or with VTK's ordinary
 // depth-tested mapper (the references), into an offscreen window. Merged polygons (isosurfaces,
 // slices: Frame::level kMergedLevel) are drawn with their own RGBA; the terrain with its
@@ -140,7 +140,7 @@ class TerrainRenderer {
                         const ColorTexture& texture = {});
   // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only
   // appended merged vertices, so only they are added: `positions` are the new tail of the
-  // tree's positions() and `colors` their merged colours (normal +z, shade 1, no texture, as
+  // tree's positions() and `colors` their merged colours (shade 1, no texture, as
   // vertex_shading gives merged vertices). The triangles drawn stay valid. Throws
   // std::invalid_argument when the counts differ.
   void append_merged_vertices(std::span<const glm::vec3> positions, std::span<const glm::u8vec4> colors);
@@ -189,8 +189,9 @@ class TerrainRenderer {
   // The last rendered image (the back buffer, not re-rendered): window_rgb(window()).
   std::vector<std::uint8_t> rgb() const;
 
-  // The scene: every point, arrays "normals", "rgba" (point data), the current triangles in draw
-  // order, and with lod_colors the cell array "lod_rgba" and always "level" (cell data).
+  // The scene: every point (the lattice's first, sample (i, j) at j * (n + 1) + i), the array
+  // "rgba" (point data), the current triangles in draw order, and with lod_colors the cell array
+  // "lod_rgba" and always "level" (cell data).
   vtkPolyData* scene() { return poly_; }
   vtkCamera* camera();
   vtkRenderer* renderer() { return renderer_; }

@@ -103,7 +103,6 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
   const int side = cells + 1;
   const std::size_t count = static_cast<std::size_t>(side) * side;
   TerrainShading out;
-  out.normals.resize(count);
   out.shade.resize(count);
   out.rgba.resize(count);
 
@@ -121,20 +120,17 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
   const double flat = std::max(std::sin(el), 1e-3);
   const double ambient = std::clamp(options.ambient, 0.0, 1.0);
 
-  auto zat = [&](int j, int i) { return static_cast<double>(z[static_cast<std::size_t>(j) * side + i]); };
+  const auto x = [&](int i) { return xs[static_cast<std::size_t>(i)]; };
+  const auto y = [&](int j) { return ys[static_cast<std::size_t>(j)]; };
+  const auto zat = [&](int i, int j) { return z[static_cast<std::size_t>(j) * side + static_cast<std::size_t>(i)]; };
   for (int j = 0; j < side; ++j) {
-    const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, cells);
     for (int i = 0; i < side; ++i) {
-      const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, cells);
-      const double dzdx = (zat(j, i1) - zat(j, i0)) / (xs[i1] - xs[i0]);
-      const double dzdy = (zat(j1, i) - zat(j0, i)) / (ys[j1] - ys[j0]);
-      const glm::dvec3 n = glm::normalize(glm::dvec3(-dzdx, -dzdy, 1.0));
+      const glm::dvec3 n = lattice_normal(cells, i, j, x, y, zat);
       const std::size_t t = static_cast<std::size_t>(j) * side + i;
       const float h = heights[t];
       // Lambert against the sun, normalised so that flat ground keeps its tint.
       const double lambert = std::max(glm::dot(n, sun), 0.0) / flat;
       const float s = h <= 0.0f ? 1.0f : static_cast<float>(std::min(ambient + (1.0 - ambient) * lambert, 1.3));
-      out.normals[t] = glm::vec3(n);
       out.shade[t] = s;
       out.rgba[t] = shaded(tint_of(h, options.tint, lo, hi), s);
     }
@@ -177,18 +173,15 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   const std::size_t total = terrain_vertices + merged_colors.size();
   const auto side = static_cast<std::size_t>(std::lround(std::sqrt(static_cast<double>(samples))));
   TerrainShading out;
-  out.normals.resize(total);
   out.shade.resize(total);
   out.rgba.resize(total);
   out.tcoords.resize(total, glm::vec2(-1.0f));
   for (std::size_t v = samples; v < terrain_vertices; ++v) {
-    out.normals[v] = glm::vec3(0.0f, 0.0f, 1.0f);
     out.shade[v] = 1.0f;
     out.rgba[v] = kWallColor;
   }
   for (std::size_t v = 0; v < std::min(terrain_vertices, samples); ++v) {
     const std::size_t t = v;
-    out.normals[v] = lattice.normals[t];
     out.shade[v] = lattice.shade[t];
     out.rgba[v] = lattice.rgba[t];
     out.tcoords[v] = glm::vec2((static_cast<float>(t % side) + 0.5f) / static_cast<float>(side),
@@ -196,7 +189,6 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   }
   for (std::size_t k = 0; k < merged_colors.size(); ++k) {
     const glm::u8vec4 c = merged_colors[k];
-    out.normals[terrain_vertices + k] = glm::vec3(0.0f, 0.0f, 1.0f);
     out.shade[terrain_vertices + k] = 1.0f;
     out.rgba[terrain_vertices + k] = {c.r, c.g, c.b, c.a};
   }

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -30,17 +31,29 @@ struct ShadingOptions {
   Tint tint = Tint::kAtlas;
 };
 
-// Per-vertex normals, shading and colours: of the (n+1)^2 lattice samples (index
-// j * (n + 1) + i, row 0 south) from shade_terrain, or of every vertex of the tree from
-// vertex_shading.
+// Per-vertex shading and colours: of the (n+1)^2 lattice samples (index j * (n + 1) + i, row 0
+// south) from shade_terrain, or of every vertex of the tree from vertex_shading. No normals: the
+// drawing is unlit (the shading is baked into the colours), and a 4096-cell window's would take
+// 200 MB in each copy; lattice_normal gives them where they are written (--export-vtp).
 struct TerrainShading {
-  std::vector<glm::vec3> normals;  // unit, scene frame
   std::vector<float> shade;        // hillshade factor, 1 on flat ground, ambient .. 1.3
   std::vector<Rgba> rgba;          // tint times shade; alpha 255
   // vertex_shading only: where the vertex's sample lies in a (n+1) x (n+1) texture of the
   // lattice colours (texel centres; row 0 south), for drawing colours independent of the LOD.
   std::vector<glm::vec2> tcoords;
 };
+
+// The unit normal (scene frame) of lattice sample (i, j) of an n-cell lattice, by central
+// differences of z (one-sided at the edges): x(i) and y(j) are the samples' plane offsets,
+// z(i, j) their heights (with the curvature drop). Precondition: cells >= 1, 0 <= i, j <= cells.
+template <typename X, typename Y, typename Z>
+glm::dvec3 lattice_normal(int cells, int i, int j, const X& x, const Y& y, const Z& z) {
+  const int i0 = i > 0 ? i - 1 : 0, i1 = i < cells ? i + 1 : cells;
+  const int j0 = j > 0 ? j - 1 : 0, j1 = j < cells ? j + 1 : cells;
+  const double dzdx = (static_cast<double>(z(i1, j)) - static_cast<double>(z(i0, j))) / (static_cast<double>(x(i1)) - static_cast<double>(x(i0)));
+  const double dzdy = (static_cast<double>(z(i, j1)) - static_cast<double>(z(i, j0))) / (static_cast<double>(y(j1)) - static_cast<double>(y(j0)));
+  return glm::normalize(glm::dvec3(-dzdx, -dzdy, 1.0));
+}
 
 // cells: n; xs, ys: plane offsets (metres, increasing); z: (n+1)^2 scene-frame heights (with
 // the curvature drop), used for the normals (central differences inside, one-sided at the

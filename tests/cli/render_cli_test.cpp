@@ -202,6 +202,15 @@ TEST(RenderCli, ExportVtpHoldsTheDrawnTrianglesAndTheCamera) {
   vtkDataArray* rgba = poly->GetPointData()->GetArray("rgba");
   ASSERT_NE(rgba, nullptr);
   EXPECT_EQ(rgba->GetNumberOfComponents(), 4);
+  // Normals made at export from the lattice's points: unit, and up on terrain.
+  vtkDataArray* normals = poly->GetPointData()->GetNormals();
+  ASSERT_NE(normals, nullptr);
+  ASSERT_EQ(normals->GetNumberOfTuples(), poly->GetNumberOfPoints());
+  for (vtkIdType v = 0; v < normals->GetNumberOfTuples(); ++v) {
+    const double* n = normals->GetTuple3(v);
+    ASSERT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-5) << v;
+    ASSERT_GT(n[2], 0.0) << v;
+  }
   vtkFieldData* fd = poly->GetFieldData();
   for (const char* name : {"camera_position", "camera_focal_point", "camera_view_up", "camera_view_angle", "background"}) {
     EXPECT_NE(fd->GetArray(name), nullptr) << name;

@@ -27,7 +27,6 @@ TwoSquares two_squares(std::uint8_t near_alpha) {
     for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}})
       s.positions.emplace_back(x, y, z);
   for (int v = 0; v < 8; ++v) {
-    s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
     s.shading.shade.push_back(1.0f);
     s.shading.rgba.push_back(v < 4 ? scene::Rgba{255, 0, 0, near_alpha} : scene::Rgba{0, 0, 255, 255});
   }
@@ -123,7 +122,6 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
     // Four more vertices: a white square at z = 8, drawn last.
     for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
       s.positions.emplace_back(x, y, 8.0f);
-      s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
       s.shading.shade.push_back(1.0f);
       s.shading.rgba.push_back(scene::Rgba{255, 255, 255, 255});
     }
@@ -152,7 +150,6 @@ TexturedRun textured_run(std::int8_t run_level) {
   TexturedRun s;
   auto vertex = [&](float x, float y, float z, scene::Rgba c, glm::vec2 t) {
     s.positions.emplace_back(x, y, z);
-    s.shading.normals.emplace_back(0.0f, 0.0f, 1.0f);
     s.shading.shade.push_back(1.0f);
     s.shading.rgba.push_back(c);
     s.shading.tcoords.push_back(t);
