@@ -48,6 +48,9 @@ struct FlyOptions {
   std::string size;  // empty: the scene's, else 1280x720
   std::optional<double> threshold, start, end;
   int crf = 20;
+  // zlib's fastest: the default level (5) took 38% of a tiled 8 x 8 export's wall time over
+  // N44W072 at 1280x720 in frames 22% smaller (81 frames: 13.0 s and 45 MB against 8.1 s and 55 MB).
+  int png_level = 1;
   int samples = 1;
   RendererChoice drawn;  // --renderer, --aa
   bool resume = false, force = false;
@@ -288,7 +291,7 @@ void run_fly(const FlyOptions& o) {
   if (video) {
     sink = std::make_unique<output::VideoSink>(o.output, width, height, o.fps, o.crf, o.force);
   } else {
-    sink = std::make_unique<output::PngSequenceSink>(o.output, width, height, digits);
+    sink = std::make_unique<output::PngSequenceSink>(o.output, width, height, digits, o.png_level);
     const std::string text = manifest.dump(2) + "\n";
     output::write_file_atomically(o.output / kManifest, std::vector<std::uint8_t>(text.begin(), text.end()), true);
   }
@@ -372,6 +375,9 @@ void add_fly_command(CLI::App& app) {
   add_density_option(*cmd, o->density);
   auto* density_threshold = add_density_threshold_option(*cmd, raw->density_threshold);
   cmd->add_option("--crf", o->crf, "H.264 quality, 0 (lossless) .. 51 (worst)")->capture_default_str();
+  auto* png_level = cmd->add_option("--png-level", o->png_level,
+                                    "PNG frames' zlib compression, 0 (none) .. 9 (smallest, slowest)")
+                        ->capture_default_str();
   auto* start = cmd->add_option("--start", raw->start, "First time to export, seconds on the path's clock");
   auto* end = cmd->add_option("--end", raw->end, "Last time to export, seconds on the path's clock");
   cmd->add_option("--stats", o->stats, "Per-frame figures (CSV)");
@@ -383,9 +389,15 @@ void add_fly_command(CLI::App& app) {
                   "the size and box-filtered down)")
       ->capture_default_str();
   add_renderer_options(*cmd, raw->renderer);
-  cmd->callback([o, raw, threshold, start, end, density_threshold] {
+  cmd->callback([o, raw, threshold, start, end, density_threshold, png_level] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
+    if (o->png_level < 0 || o->png_level > 9) {
+      throw std::invalid_argument("--png-level " + std::to_string(o->png_level) + ": must be within 0..9");
+    }
+    if (png_level->count() > 0 && is_video(o->output)) {
+      throw std::invalid_argument("--png-level: for PNG frames; " + o->output.string() + " is a video (--crf sets its quality)");
+    }
     if (o->samples != 1 && o->samples != 4 && o->samples != 9 && o->samples != 16) {
       throw std::invalid_argument("--samples " + std::to_string(o->samples) + ": must be 1, 4, 9 or 16");
     }

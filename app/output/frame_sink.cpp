@@ -166,8 +166,8 @@ void VideoSink::finish() {
   finished_ = true;
 }
 
-PngSequenceSink::PngSequenceSink(const std::filesystem::path& folder, int width, int height, int digits)
-    : folder_(folder), width_(width), height_(height), digits_(digits) {
+PngSequenceSink::PngSequenceSink(const std::filesystem::path& folder, int width, int height, int digits, int level)
+    : folder_(folder), width_(width), height_(height), digits_(digits), level_(level) {
   std::error_code ec;
   std::filesystem::create_directories(folder, ec);
   if (ec || !std::filesystem::is_directory(folder)) {
@@ -176,7 +176,7 @@ PngSequenceSink::PngSequenceSink(const std::filesystem::path& folder, int width,
 }
 
 void PngSequenceSink::write(long index, std::span<const std::uint8_t> rgb) {
-  write_png(folder_ / frame_name(index, digits_), encode_png(rgb, width_, height_), true);
+  write_png(folder_ / frame_name(index, digits_), encode_png(rgb, width_, height_, 3, level_), true);
 }
 
 std::string frame_name(long index, int digits) {

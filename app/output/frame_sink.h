@@ -54,18 +54,18 @@ class VideoSink : public FrameSink {
 };
 
 // A folder of PNG files named frame_name(index, digits), each written through a temporary
-// file and a rename (a reader or a resumed export never sees half a frame). The folder is
-// created when missing. Existing frames are replaced (the caller decides; see
-// existing_frames).
+// file and a rename (a reader or a resumed export never sees half a frame), at zlib
+// compression `level` (encode_png). The folder is created when missing. Existing frames are
+// replaced (the caller decides; see existing_frames).
 class PngSequenceSink : public FrameSink {
  public:
-  PngSequenceSink(const std::filesystem::path& folder, int width, int height, int digits);
+  PngSequenceSink(const std::filesystem::path& folder, int width, int height, int digits, int level = 5);
   void write(long index, std::span<const std::uint8_t> rgb) override;
   void finish() override {}
 
  private:
   std::filesystem::path folder_;
-  int width_, height_, digits_;
+  int width_, height_, digits_, level_;
 };
 
 // "frame_000042.png" with `digits` digits (at least as many as index needs).

@@ -14,7 +14,8 @@
 
 namespace terravol::app::output {
 
-std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> pixels, int width, int height, int channels) {
+std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> pixels, int width, int height, int channels, int level) {
+  if (level < 0 || level > 9) throw std::invalid_argument("encode_png: compression level " + std::to_string(level) + " outside 0..9");
   const std::size_t row = static_cast<std::size_t>(width) * static_cast<std::size_t>(channels);
   if (width <= 0 || height <= 0 || (channels != 3 && channels != 4) || pixels.size() != row * height) {
     throw std::invalid_argument("encode_png: " + std::to_string(pixels.size()) + " bytes for " + std::to_string(width) +
@@ -30,6 +31,7 @@ std::vector<std::uint8_t> encode_png(std::span<const std::uint8_t> pixels, int w
   vtkNew<vtkPNGWriter> writer;
   writer->SetInputData(image);
   writer->WriteToMemoryOn();
+  writer->SetCompressionLevel(level);
   writer->Write();
   vtkUnsignedCharArray* bytes = writer->GetResult();
   if (bytes == nullptr || bytes->GetNumberOfValues() == 0) throw std::runtime_error("PNG encoding failed");

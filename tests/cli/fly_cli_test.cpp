@@ -254,6 +254,8 @@ TEST(FlyCli, BadPathFilesFailWithOneLineBeforeAnyFrame) {
   expect_rejected(dir, "{\"scene\": ", "bad.json: not valid JSON (byte 11)");
   expect_rejected(dir, flight().dump(), "--end 9.000: must be within --start .. 4.000 s", "--end 9");
   expect_rejected(dir, flight().dump(), "--samples 3: must be 1, 4, 9 or 16", "--samples 3");
+  expect_rejected(dir, flight().dump(), "--png-level 10: must be within 0..9", "--png-level 10");
+  expect_rejected(dir, flight().dump(), "--png-level: for PNG frames; ", "--png-level 3", "out.mp4");
   expect_rejected(dir, flight().dump(), "out.avi: not a video", "", "out.avi");
 }
 

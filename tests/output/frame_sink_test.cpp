@@ -4,7 +4,11 @@
 #include "app/output/png_output.h"
 
 #include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
 
+#include <algorithm>
 #include <fstream>
 #include <random>
 #include <string>
@@ -74,6 +78,36 @@ TEST(FrameSink, PngRoundTripKeepsPixelsAndIsDeterministic) {
   ASSERT_GT(a.size(), 8u);
   EXPECT_EQ(a[1], 'P');
   EXPECT_THROW(encode_png(rgb, 4, 3), std::invalid_argument);
+}
+
+// Every zlib level decodes (vtkPNGReader, not our encoder) to the same pixels; level 0 stores
+// them, 9 is the smallest.
+TEST(FrameSink, PngLevelsTradeSizeAndKeepPixels) {
+  const int w = 64, h = 48;
+  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(w * h * 3));
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<std::uint8_t>((i / 3) % 97 + (rng() % 4));
+  std::vector<std::size_t> sizes;
+  for (int level : {0, 1, 9}) {
+    const std::vector<std::uint8_t> png = encode_png(rgb, w, h, 3, level);
+    sizes.push_back(png.size());
+    vtkNew<vtkPNGReader> reader;
+    reader->SetMemoryBuffer(png.data());
+    reader->SetMemoryBufferLength(png.size());
+    reader->Update();
+    vtkImageData* image = reader->GetOutput();
+    ASSERT_EQ(image->GetNumberOfScalarComponents(), 3) << level;
+    const auto* decoded = static_cast<const std::uint8_t*>(image->GetScalarPointer());
+    for (int y = 0; y < h; ++y) {  // VTK's rows go bottom up
+      ASSERT_TRUE(std::equal(decoded + static_cast<std::size_t>(y * w * 3), decoded + static_cast<std::size_t>((y + 1) * w * 3),
+                             rgb.begin() + (h - 1 - y) * w * 3))
+          << "level " << level << ", row " << y;
+    }
+  }
+  EXPECT_GT(sizes[0], sizes[1]);
+  EXPECT_GE(sizes[1], sizes[2]);
+  EXPECT_THROW(encode_png(rgb, w, h, 3, 10), std::invalid_argument);
+  EXPECT_THROW(encode_png(rgb, w, h, 3, -1), std::invalid_argument);
 }
 
 TEST(FrameSink, AbandonedVideoLeavesNoFile) {
