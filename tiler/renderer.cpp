@@ -352,6 +352,8 @@ struct Texture {
   }
 };
 
+// What every triangle is shaded with: the lattice texture, the walls' colour, the haze; a call
+// shades four points of one triangle.
 struct Shader {
   Texture texture;
   std::array<float, 3> wall_rgb{};

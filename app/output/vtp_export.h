@@ -20,7 +20,8 @@ namespace terravol::app::output {
 // frame), camera_view_angle (vertical, degrees), camera_clipping_range, background (3 x uint8,
 // 0..255; the bottom colour of a gradient) and, for a gradient sky, background_top.
 // Written through a temporary file in the same folder and a rename. Throws
-// std::runtime_error when `path` exists and !overwrite, or when writing fails.
+// std::runtime_error when `path` exists and !overwrite, or when writing fails, and
+// std::invalid_argument when `scene` has fewer points than the lattice.
 void export_vtp(const std::filesystem::path& path, vtkPolyData* scene, int lattice_cells, vtkCamera* camera,
                 const render::RenderSettings& settings, bool overwrite);
 
