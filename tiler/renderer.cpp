@@ -779,6 +779,11 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   const std::uint64_t full = rect_mask(0, aa, 0, aa);
   const int per_tile = 8 / aa;  // pixels per tile side
   const float inv_aa = 1.0f / static_cast<float>(aa);
+  const glm::vec2 centre(0.5f * static_cast<float>(aa));  // of a pixel's samples, from its low corner
+  // A pixel's samples `sub` (not empty): a whole pixel's without counting.
+  const auto pixel_samples = [&](std::uint64_t sub) {
+    return sub == full ? Samples{N, centre} : samples(sub);
+  };
   Shader shader;
   shader.texture = {colors.texture.data(), static_cast<int>(side)};
   shader.wall_rgb = {static_cast<float>(colors.wall_color.r), static_cast<float>(colors.wall_color.g), static_cast<float>(colors.wall_color.b)};
@@ -882,7 +887,6 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
           }
         }
       };
-      const glm::vec2 centre(0.5f * static_cast<float>(aa));
       for (const coverage::TileMask& rec : st.records) {
         if (rec.run > 1) {
           // Whole tiles (a cell the triangle covers): every sample of every pixel, vacant before.
@@ -895,7 +899,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
         if (per_tile == 1) {  // aa = 8: the tile is one pixel, its mask the pixel's samples
           const std::uint64_t sub = rec.mask;
           if (!sub) continue;
-          const Samples at = sub == full ? Samples{N, centre} : samples(sub);
+          const Samples at = pixel_samples(sub);
           fragment(rec.tx, rec.ty, sub, at.count, at.centroid, sh.translucent ? pyramid.tile_bits(rec.tx, rec.ty) : 0);
           continue;
         }
@@ -904,8 +908,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             const int shift = 8 * j * aa + i * aa;
             const std::uint64_t sub = (rec.mask >> shift) & full;
             if (!sub) continue;
-            const bool whole = sub == full;
-            const Samples at = whole ? Samples{N, centre} : samples(sub);
+            const Samples at = pixel_samples(sub);
             const std::uint64_t covered = sh.translucent ? (pyramid.tile_bits(rec.tx, rec.ty) >> shift) & full : 0;
             fragment(rec.tx * per_tile + i, rec.ty * per_tile + j, sub, at.count, at.centroid, covered);
           }
@@ -930,7 +933,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
             if (!sub) continue;
             const int px = tx * per_tile + i, py = ty * per_tile + j;
             const std::size_t p = static_cast<std::size_t>(py) * static_cast<std::size_t>(W) + static_cast<std::size_t>(px);
-            const Samples at = sub == full ? Samples{N, glm::vec2(0.5f * aa)} : samples(sub);
+            const Samples at = pixel_samples(sub);
             const int c = at.count;
             const float qy = at.centroid.y;
             const float f = (static_cast<float>(row0 + py) + qy * inv_aa) * inv_h;

@@ -42,8 +42,9 @@ struct Settings {
   // have colours linear across them and are shaded at each fragment's centroid.
   // The default, 0.25 (blocks once a pixel spans 4 texels or more), against 1.0: the bench's
   // quick aa suite over N44W072 (3 views) at 1280x720 and 8 x 8 drew its terrain views 1.2x
-  // faster against VTK (1.33 shading points a pixel down to 0.80) at 54.6 dB against the 16 x 16 supersampled reference instead
-  // of 54.9 dB; shading once per fragment (0.01) gave 54.4 dB.
+  // faster against VTK (1.33 shading points a pixel down to 0.80) at 54.6 dB against the
+  // 16 x 16 supersampled reference instead of 54.9 dB; shading once per fragment (0.01) gave
+  // 54.4 dB.
   double texel_rate = 0.25;
   int band_rows = 64;  // output pixel rows per band; bands are tiled in parallel, each with its own pyramid
   int threads = 0;     // worker threads, 0: TBB's default

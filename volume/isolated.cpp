@@ -103,7 +103,7 @@ IsolatedRun run_isolated(const std::function<std::string()>& work, std::size_t e
   run.timed_out = timed_out;
   if (timed_out) {
     char b[64];
-    std::snprintf(b, sizeof b, "took longer than %.0f s", timeout_seconds);
+    std::snprintf(b, sizeof b, "took longer than %g s", timeout_seconds);
     run.failure = b;
   } else if (WIFSIGNALED(status)) {
     run.failure = "crashed (signal " + std::to_string(WTERMSIG(status)) + ": " + ::strsignal(WTERMSIG(status)) + ")";
