@@ -102,8 +102,8 @@ constexpr std::uint64_t rect_mask(int x0, int w, int y0, int h) {
 // call to a popcnt version chosen at run time cost more than the counts (its return went
 // through the stack).
 struct Samples {
-  int count;
   glm::vec2 centroid;
+  int count;
 };
 struct SampleTables {
   std::array<std::uint16_t, 256> row{};  // count in the low byte, the sum of x in the high one
@@ -131,7 +131,7 @@ inline Samples samples(std::uint64_t m) {
   }
   const unsigned count = both & 0xFFu, sx = both >> 8;
   const float inv = kSampleTables.inverse[count];
-  return {static_cast<int>(count), {static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f}};
+  return {{static_cast<float>(sx) * inv + 0.5f, static_cast<float>(sy) * inv + 0.5f}, static_cast<int>(count)};
 }
 
 int pow2_at_least(double v, int cap) {
@@ -782,7 +782,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
   const glm::vec2 centre(0.5f * static_cast<float>(aa));  // of a pixel's samples, from its low corner
   // A pixel's samples `sub` (not empty): a whole pixel's without counting.
   const auto pixel_samples = [&](std::uint64_t sub) {
-    return sub == full ? Samples{N, centre} : samples(sub);
+    return sub == full ? Samples{centre, N} : samples(sub);
   };
   Shader shader;
   shader.texture = {colors.texture.data(), static_cast<int>(side)};
@@ -882,7 +882,7 @@ Stats Renderer::render(const SceneColors& colors, const Look& look, const mrbsp:
           for (int bx = 0; bx < sh.kx; ++bx) {
             const std::uint64_t part = sub & rect_mask(bx * bw, bw, by * bh, bh);
             if (!part) continue;
-            const auto [pc, pq] = samples(part);
+            const auto [pq, pc] = samples(part);
             shade(p, part, pc, static_cast<float>(px) + pq.x * inv_aa, y_base + static_cast<float>(py) + pq.y * inv_aa, 0);
           }
         }
