@@ -16,6 +16,8 @@
 #include <vtkProperty2D.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderStepsPass.h>
+#include <vtkFramebufferPass.h>
+#include <vtkTextureObject.h>
 #include <vtkCullerCollection.h>
 #include <vtkRenderer.h>
 #include <vtkActor2D.h>
@@ -264,7 +266,29 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
   window_->AddRenderer(labels_renderer_);
 }
 
-TerrainRenderer::~TerrainRenderer() { window_->Finalize(); }
+TerrainRenderer::~TerrainRenderer() {
+  if (float_pass_) {
+    window_->MakeCurrent();
+    float_pass_->ReleaseGraphicsResources(window_);
+  }
+  window_->Finalize();
+}
+
+void TerrainRenderer::use_float_target(bool on) {
+  if (on == (float_pass_ != nullptr && renderer_->GetPass() == float_pass_)) return;
+  if (on) {
+    if (!float_pass_) {
+      float_pass_ = vtkSmartPointer<vtkFramebufferPass>::New();
+      float_pass_->SetColorFormat(vtkTextureObject::Float32);
+      float_pass_->SetDelegatePass(vtkNew<vtkRenderStepsPass>());
+    }
+    renderer_->SetPass(float_pass_);
+  } else {
+    window_->MakeCurrent();
+    float_pass_->ReleaseGraphicsResources(window_);  // its colour and depth textures
+    renderer_->SetPass(nullptr);
+  }
+}
 
 vtkCamera* TerrainRenderer::camera() { return renderer_->GetActiveCamera(); }
 
@@ -332,6 +356,7 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
     }
     blend_if_translucent(frame.transient_colors);
   }
+  use_float_target(settings_.order == scene::DrawOrder::kBsp && own > 0);
   // The split orders draw the merged triangles with a second actor: the terrain's list keeps
   // the rest, in the frame's order (buffers reused from frame to frame).
   const std::vector<std::uint32_t>* terrain = &frame.indices;

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 #include <vtkPolyData.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "app/render/ordered_mapper.h"
 #include "app/render/terrain_renderer.h"
+#include "mrbsp/color_boxes.h"
 #include "mrbsp/terrain_tree.h"
 #include "image_compare.h"
 #include "require_display.h"
@@ -201,6 +204,60 @@ TEST(TerrainRenderer, LongRunsOfMergedPiecesDrawnWithoutTheTextureGiveTheSameIma
   EXPECT_NEAR(blended[0], 127, 2);
   EXPECT_NEAR(blended[1], 127, 2);
   EXPECT_NEAR(blended[2], 128, 2);
+}
+
+// Colour-box faces (a density) are many faint layers over a pixel. 300 black faces of opacity
+// 1/255 over the white far square leave 255 (254/255)^300 = 78.7 in exact arithmetic; blended
+// into 8 bits, every step rounds, and the colour stops moving once a step is under half a unit
+// (near 128) or falls to 0 when rounded down. A frame with such faces is blended in float
+// (TerrainRenderer::use_float_target); the same triangles as merged pieces, in 8 bits, show
+// the difference, and a frame without faces afterwards is drawn as before.
+TEST(TerrainRenderer, ManyFaintColourBoxFacesBlendAsInExactArithmetic) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  TwoSquares s = two_squares(255);
+  s.shading.rgba.assign(8, scene::Rgba{255, 255, 255, 255});
+  constexpr int kLayers = 300;
+  const double exact = 255.0 * std::pow(254.0 / 255.0, kLayers);
+  mrbsp::Frame boxes = frame_of({4, 5, 6, 4, 6, 7});  // the white square at z = 0
+  boxes.transient_base = static_cast<std::uint32_t>(s.positions.size());
+  for (int k = 0; k < kLayers; ++k) {
+    const float z = 0.5f + 4.0f * static_cast<float>(k) / kLayers;
+    const std::uint32_t b = boxes.transient_base + static_cast<std::uint32_t>(boxes.transient_positions.size());
+    for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
+      boxes.transient_positions.emplace_back(x, y, z);
+      boxes.transient_colors.emplace_back(0, 0, 0, 1);
+    }
+    boxes.indices.insert(boxes.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+    boxes.level.insert(boxes.level.end(), {mrbsp::kBoxLevel, mrbsp::kBoxLevel});
+  }
+  TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));
+  renderer.set_camera(s.camera, 100.0);
+  renderer.set_frame(boxes);
+  renderer.render();
+  const test::Rgb8 fog = test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(fog[c], exact, 1.5) << "channel " << c;
+
+  // The same faces as the tree's own vertices (merged pieces): blended into 8 bits.
+  TwoSquares merged = s;
+  for (std::size_t v = 0; v < boxes.transient_positions.size(); ++v) {
+    merged.positions.push_back(boxes.transient_positions[v]);
+    merged.shading.shade.push_back(1.0f);
+    merged.shading.rgba.push_back(scene::Rgba{0, 0, 0, 1});
+  }
+  TerrainRenderer eight(merged.positions, merged.shading, two_squares_settings(scene::DrawOrder::kBsp));
+  eight.set_camera(s.camera, 100.0);
+  mrbsp::Frame pieces = frame_of(boxes.indices);
+  pieces.level = boxes.level;
+  std::fill(pieces.level.begin() + 2, pieces.level.end(), mrbsp::kMergedLevel);
+  eight.set_frame(pieces);
+  eight.render();
+  EXPECT_GT(std::abs(test::image_of_rgb(eight.rgb(), 64, 64).at(32, 32)[0] - exact), 20.0) << "8 bits round it away";
+
+  // No faces: the white square as it is.
+  renderer.set_frame(frame_of({4, 5, 6, 4, 6, 7}));
+  renderer.render();
+  EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32), (test::Rgb8{255, 255, 255}));
+  EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(2, 2), (test::Rgb8{0, 255, 0})) << "the background";
 }
 
 }  // namespace
