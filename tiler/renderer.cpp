@@ -100,7 +100,9 @@ constexpr std::uint64_t rect_mask(int x0, int w, int y0, int h) {
 // corner (sample centres at +0.5). Row by row from a table of each byte's count and sum of x
 // (8 lookups, inlined): the build targets baseline x86-64, without the popcnt instruction, and a
 // call to a popcnt version chosen at run time cost more than the counts (its return went
-// through the stack).
+// through the stack). The centroid comes first: with the count first, copies of the struct read
+// the count and centroid.x as one 8-byte word written as two, a store-forwarding stall that perf
+// put at a tenth of the band loop.
 struct Samples {
   glm::vec2 centroid;
   int count;
