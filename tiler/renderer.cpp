@@ -272,10 +272,10 @@ struct Color {
 };
 #endif
 
-// An affine function of window position, about the triangle's centre: at + a dx + b dy.
+// An affine function of window position, about the triangle's centre: at + a dx + b dy
+// (evaluated by eval(), four points at once).
 struct Plane {
   float a = 0, b = 0, at = 0;
-  float operator()(float dx, float dy) const { return at + a * dx + b * dy; }
 };
 
 // What a triangle is shaded with. Attributes are interpolated perspective-correctly by the

@@ -84,7 +84,7 @@ void OrderedPolyDataMapper::BuildBufferObjects(vtkRenderer* ren, vtkActor* act) 
   // array and the GL buffer (host memory under llvmpipe); it packs again from the arrays for
   // every upload, so the copy is freed here. That is about 400 MB less held through a session
   // with a 4096-cell window, but not a lower peak: every copy exists at the end of the upload.
-  for (const char* name : {"vertexMC", "normalMC", "tcoord", "scalarColor"}) {
+  for (const char* name : {"vertexMC", "tcoord", "scalarColor"}) {
     if (vtkOpenGLVertexBufferObject* vbo = this->VBOs->GetVBO(name)) std::vector<float>().swap(vbo->GetPackedVBO());
   }
   if (update_count_ == 0) return;
