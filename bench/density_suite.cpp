@@ -157,21 +157,26 @@ json lattice_series(const BenchConfig& c, const Terrain& terrain, const std::fil
       scene.set_density_options(every);
       scene.render(pose, false, 45.0, traversal);  // warm-up
     }
-    std::vector<double> a, b;
+    std::vector<double> a, b, wall_a, wall_b;
     app::render::FrameStats sa, sb;
     for (int r = 0; r < c.repeats; ++r) {
       scene.set_density_options(octree);
+      auto t0 = Clock::now();
       sa = scene.render(pose, false, 45.0, traversal);
+      wall_a.push_back(ms_since(t0));
       a.push_back(density_frame_ms(sa));
       if (draw_every) {
         scene.set_density_options(every);
+        t0 = Clock::now();
         sb = scene.render(pose, false, 45.0, traversal);
+        wall_b.push_back(ms_since(t0));
         b.push_back(density_frame_ms(sb));
       }
     }
     scene.set_density_options(octree);
     json view = {{"radii", radii},
                  {"octree_ms", median(a)},
+                 {"octree_wall_ms", median(wall_a)},
                  {"octree_cells", sa.density.boxes},
                  {"octree_cells_per_level", sa.density.per_level},
                  {"octree_faces", sa.boxes.faces},
@@ -183,6 +188,8 @@ json lattice_series(const BenchConfig& c, const Terrain& terrain, const std::fil
       view["every_ms"] = median(b);
       view["every_faces"] = sb.boxes.faces;
       view["every_over_octree"] = median(b) / median(a);
+      view["every_wall_ms"] = median(wall_b);
+      view["every_over_octree_wall"] = median(wall_b) / median(wall_a);
     }
     char line[256];
     std::snprintf(line, sizeof line, "density %dx: %.2f radii: octree %.1f ms (%zu cells), every cell %s (%zu cells)", factor,
@@ -258,25 +265,33 @@ json density_suite(const BenchConfig& c, const Terrain& terrain) {
     say(c, std::string("density: the default RF volume") + (surfaces ? " with its isosurfaces and slice" : ""));
     app::render::SceneRenderer scene(surfaces ? with : spec, plain_settings(c), bench_scene_options());
     scene.render(pose, false, 45.0, traversal);
-    std::vector<double> t, change;
+    std::vector<double> t, wall, change;
     app::render::FrameStats s;
     for (int r = 0; r < c.repeats; ++r) {
+      const auto t0 = Clock::now();
       s = scene.render(pose, false, 45.0, traversal);
+      wall.push_back(ms_since(t0));
       t.push_back(density_frame_ms(s));
     }
     // A transfer-function change (the opacity, alternately up and back) to the finished frame.
     density::DensitySpec d = *scene.volumes().spec(0).density;
+    std::vector<double> set_ms, after_ms;
     for (int r = 0; r < c.repeats; ++r) {
       d.sigma_per_km = r % 2 == 0 ? 0.75 : 0.5;
       const auto t0 = Clock::now();
       scene.volumes().set_density(0, d);
-      scene.render(pose, false, 45.0, traversal);
+      set_ms.push_back(ms_since(t0));
+      const app::render::FrameStats after = scene.render(pose, false, 45.0, traversal);
       change.push_back(ms_since(t0));
+      after_ms.push_back(density_frame_ms(after));
     }
     const app::scene::DensityFigures fig = scene.volumes().density_figures();
     json j = {{"surfaces", surfaces},
               {"frame_ms", to_json(summarize(t))},
+              {"frame_wall_ms", to_json(summarize(wall))},
               {"transfer_change_to_frame_ms", to_json(summarize(change))},
+              {"transfer_change_set_ms", to_json(summarize(set_ms))},
+              {"transfer_change_frame_ms", to_json(summarize(after_ms))},
               {"build_ms", fig.build_ms},
               {"leaves", fig.grid.boxes},
               {"octree_bytes", fig.bytes},
@@ -291,8 +306,9 @@ json density_suite(const BenchConfig& c, const Terrain& terrain) {
               {"upload_ms", s.upload_ms},
               {"draw_ms", s.draw_ms}};
     char line[200];
-    std::snprintf(line, sizeof line, "density: default volume%s: frame %.0f ms (%zu cells, %zu faces), transfer change to frame %.0f ms",
-                  surfaces ? " with surfaces" : "", median(t), s.density.boxes, s.boxes.faces, median(change));
+    std::snprintf(line, sizeof line,
+                  "density: default volume%s: frame %.0f ms (wall %.0f ms; %zu cells, %zu faces), transfer change to frame %.0f ms",
+                  surfaces ? " with surfaces" : "", median(t), median(wall), s.density.boxes, s.boxes.faces, median(change));
     say(c, line);
     if (surfaces) {
       // Exactness: bsp against VTK's depth peeling (no peel limit) of the same polygons, with

@@ -341,8 +341,13 @@ void TerrainRenderer::set_frame(const mrbsp::Frame& frame) {
                                   std::to_string(frame.transient_base) + ", after " + std::to_string(point_rgba_.size()) +
                                   " vertices of the tree here");
     }
+    // Room for an eighth more than asked: a density's face count moves by a few hundred when
+    // its transfer function or the view changes a little, and an exact fit made the next such
+    // frame grow the tail, so upload every vertex again (1.0 s more upload and 2.5 s more draw
+    // for the 21 million face vertices of the bench's default density, whose frames take 3 s).
+    // The eighth costs 3 of a face vertex's 24 bytes; doubling cost all 24 again.
     const bool grown = own > tail_;
-    if (grown) reserve_tail(std::max({own, 2 * tail_, std::size_t{4096}}));
+    if (grown) reserve_tail(std::max({own + own / 8, tail_ + tail_ / 8, std::size_t{4096}}));
     const std::size_t base = point_rgba_.size();
     write_vertices(base, frame.transient_positions, frame.transient_colors.data());
     auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);

@@ -112,8 +112,9 @@ class TerrainRenderer {
   // Replaces the triangle list with the frame's, in its order (and, with lod_colors, the
   // per-triangle colours: lod_color(level) times the mean shade of the three vertices).
   // The frame's own vertices (colour-box faces: Frame::transient_positions, from index
-  // transient_base) go after the tree's, in a tail of vertices reserved for them (grown, by
-  // doubling, when a frame needs more: that frame uploads every vertex again); otherwise
+  // transient_base) go after the tree's, in a tail of vertices reserved for them (an eighth
+  // more than the frame that grew it needed: a frame that needs more grows it again and
+  // uploads every vertex again); otherwise
   // only they are written to the vertex buffers (OrderedPolyDataMapper::update_vertices), or,
   // for the other orders, everything is uploaded again. Throws std::invalid_argument when the
   // frame's transient_base is not vertex_count() (the renderer holds other vertices than the

@@ -260,6 +260,46 @@ TEST(TerrainRenderer, ManyFaintColourBoxFacesBlendAsInExactArithmetic) {
   EXPECT_EQ(test::image_of_rgb(renderer.rgb(), 64, 64).at(2, 2), (test::Rgb8{0, 255, 0})) << "the background";
 }
 
+// A frame's face vertices go in a tail reserved after the tree's. A frame with a few more
+// of them than the one that sized the tail (a density after a small transfer-function change)
+// fits it, so its faces are written in place instead of every vertex being uploaded again;
+// many more grow it, and either way the picture shows the frame's own faces.
+TEST(TerrainRenderer, AFewMoreFaceVerticesFitTheTailAndDrawTheirOwnColours) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  TwoSquares s = two_squares(255);
+  s.shading.rgba.assign(8, scene::Rgba{255, 255, 255, 255});
+  // `quads` opaque squares at z = 1 over the white one, in `colour`.
+  const auto faces = [&](int quads, glm::u8vec4 colour) {
+    mrbsp::Frame f = frame_of({4, 5, 6, 4, 6, 7});
+    f.transient_base = static_cast<std::uint32_t>(s.positions.size());
+    for (int k = 0; k < quads; ++k) {
+      const std::uint32_t b = f.transient_base + static_cast<std::uint32_t>(f.transient_positions.size());
+      for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
+        f.transient_positions.emplace_back(x, y, 1.0f);
+        f.transient_colors.push_back(colour);
+      }
+      f.indices.insert(f.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+      f.level.insert(f.level.end(), {mrbsp::kBoxLevel, mrbsp::kBoxLevel});
+    }
+    return f;
+  };
+  TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));
+  renderer.set_camera(s.camera, 100.0);
+  const auto centre = [&](const mrbsp::Frame& f) {
+    renderer.set_frame(f);
+    renderer.render();
+    return test::image_of_rgb(renderer.rgb(), 64, 64).at(32, 32);
+  };
+
+  EXPECT_EQ(centre(faces(2000, {255, 0, 0, 255})), (test::Rgb8{255, 0, 0}));
+  const std::size_t sized = renderer.transient_capacity();
+  EXPECT_GE(sized, 8000u + 8000u / 8);
+  EXPECT_EQ(centre(faces(2100, {0, 0, 255, 255})), (test::Rgb8{0, 0, 255})) << "written in place";
+  EXPECT_EQ(renderer.transient_capacity(), sized) << "5% more vertices fit";
+  EXPECT_EQ(centre(faces(3000, {0, 255, 0, 255})), (test::Rgb8{0, 255, 0})) << "after growing";
+  EXPECT_GE(renderer.transient_capacity(), 12000u);
+}
+
 }  // namespace
 }  // namespace terravol::app::render
 
