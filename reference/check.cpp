@@ -28,6 +28,7 @@
 #include "reference/dem.h"
 #include "reference/frame.h"
 #include "reference/geometry.h"
+#include "reference/objects.h"
 #include "reference/scene.h"
 #include "volume/readers.h"
 
@@ -144,6 +145,11 @@ Reference reference_image(const fs::path& scene_file, const fs::path& vtp, const
              std::max(box.east, b.east)};
     }
   }
+  for (const ObjectStyle& o : scene.objects) {
+    if (o.height) continue;
+    ground = true;
+    box = {std::min(box.south, o.lat), std::max(box.north, o.lat), std::min(box.west, o.lon), std::max(box.east, o.lon)};
+  }
   std::unique_ptr<Dem> dem;
   if (ground) {
     if (scene.dems.empty()) throw std::runtime_error(scene_file.string() + ": volumes need the ground and the scene names no DEM");
@@ -158,6 +164,8 @@ Reference reference_image(const fs::path& scene_file, const fs::path& vtp, const
     for (const SliceStyle& sl : styles[v]->slices) append(all, slice(volumes[v], placement, sl));
   }
   r.volume_triangles = all.triangle_count();
+  for (const ObjectStyle& o : scene.objects) append(all, object(o, frame, dem.get()));
+  r.object_triangles = all.triangle_count() - r.volume_triangles;
   r.drawn = read_drawn(vtp);
   texture_terrain(r.drawn, frame, stats.window);
   r.geometry_ms = ms_since(t0);

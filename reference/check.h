@@ -15,9 +15,11 @@
 //   (reference/geometry.h), placed by this folder's own scene frame (reference/frame.h) with
 //   the frame's origin from the stats' window.origin_lat/origin_lon, the ground from the DEM's
 //   own samples (reference/dem.h);
+// - objects (the scene file's "objects"): each model read again with assimp and placed by this
+//   folder's own code (reference/objects.h), at full resolution as --full-res draws them;
 // - drawn by VTK depth peeling with no limit (reference/draw.h), with the exported camera and
 //   background, at the stats' size.
-// Nothing here includes app/, mrbsp/, volume/'s geometry or volume::LatticeMapper.
+// Nothing here includes app/, mrbsp/, objects/, volume/'s geometry or volume::LatticeMapper.
 #pragma once
 
 #include <filesystem>
@@ -41,6 +43,7 @@ struct Reference {
   Image image;
   Drawn drawn;
   std::size_t volume_triangles = 0;
+  std::size_t object_triangles = 0;  // the scene's objects, placed by reference/objects.h
   double geometry_ms = 0, draw_ms = 0;  // wall time: reading and rebuilding, then drawing
 };
 

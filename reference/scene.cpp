@@ -88,6 +88,23 @@ Scene read_scene(const fs::path& file) {
         scene.volumes.push_back(std::move(s));
       }
     }
+    if (j.contains("objects")) {
+      for (const json& o : j.at("objects")) {
+        ObjectStyle s;
+        s.file = resolve(base, o.at("file").get<std::string>());
+        s.lat = o.at("lat").get<double>();
+        s.lon = o.at("lon").get<double>();
+        if (o.contains("agl")) s.agl = o.at("agl").get<double>();
+        if (o.contains("height")) s.height = o.at("height").get<double>();
+        for (const auto& [key, to] : {std::pair{"heading", &s.heading}, std::pair{"pitch", &s.pitch},
+                                      std::pair{"roll", &s.roll}, std::pair{"scale", &s.scale},
+                                      std::pair{"opacity", &s.opacity}}) {
+          if (o.contains(key)) *to = o.at(key).get<double>();
+        }
+        if (o.contains("up")) s.up_z = o.at("up").get<std::string>() == "z";
+        scene.objects.push_back(std::move(s));
+      }
+    }
     return scene;
   } catch (const json::exception& e) {
     throw std::runtime_error(file.string() + ": " + e.what());

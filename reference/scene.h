@@ -1,5 +1,5 @@
 // What the independent reference (reference/check.h) reads of a scene file (docs/scene-file.md):
-// the DEMs and, per volume, its file, field, frame and visible styles. Parsed here with
+// the DEMs, per volume its file, field, frame and visible styles, and the objects' placements. Parsed here with
 // nlohmann-json rather than through app/scene_file.h, which is part of what is checked. Only the
 // keys the reference draws are read; the camera and render style come from the render's own
 // outputs (its --export-vtp and --stats), and validating the file is the renderer's job: unknown
@@ -40,9 +40,21 @@ struct VolumeStyle {
   std::vector<SliceStyle> slices;
 };
 
+// A model placed on the terrain (docs/scene-file.md, "objects").
+struct ObjectStyle {
+  std::filesystem::path file;   // resolved against the scene file's folder
+  double lat = 0, lon = 0;      // degrees: where the anchor stands
+  double agl = 0;               // metres above the ground there, unless `height` is given
+  std::optional<double> height; // metres above the DEM's datum
+  double heading = 0, pitch = 0, roll = 0;  // degrees
+  double scale = 1, opacity = 1;
+  bool up_z = false;            // "up": "z" (else "y")
+};
+
 struct Scene {
   std::vector<std::filesystem::path> dems;  // resolved against the scene file's folder
   std::vector<VolumeStyle> volumes;
+  std::vector<ObjectStyle> objects;
 };
 
 // Reads a scene file. Isosurfaces without a colour take volume::default_isosurface_color of
