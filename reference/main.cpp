@@ -16,7 +16,7 @@
 int main(int argc, char** argv) {
   namespace ref = terravol::reference;
   CLI::App app{"The independent reference image of a terravol render (issue 11): the exported terrain, the "
-               "volumes rebuilt from their files, VTK depth peeling without a peel limit"};
+               "volumes and objects rebuilt from their files, VTK depth peeling without a peel limit"};
   std::filesystem::path scene, drawn, stats, output, against, diff;
   bool force = false;
   app.add_option("--scene", scene, "The scene file the render drew")->required();
@@ -34,10 +34,10 @@ int main(int argc, char** argv) {
     if (!diff.empty() && against.empty()) throw std::runtime_error("--diff needs --against");
     ref::require_display();
     const ref::Reference r = ref::reference_image(scene, drawn, stats);
-    std::printf("reference: %zu terrain and %zu crack-fill triangles exported, %zu volume triangles rebuilt "
-                "(%zu merged pieces were drawn); %.0f ms to rebuild, %.0f ms to draw\n",
-                r.drawn.terrain_triangles, r.drawn.skirt_triangles, r.volume_triangles, r.drawn.merged_triangles,
-                r.geometry_ms, r.draw_ms);
+    std::printf("reference: %zu terrain and %zu crack-fill triangles exported, %zu volume and %zu object triangles "
+                "rebuilt (%zu merged pieces were drawn); %.0f ms to rebuild, %.0f ms to draw\n",
+                r.drawn.terrain_triangles, r.drawn.skirt_triangles, r.volume_triangles, r.object_triangles,
+                r.drawn.merged_triangles, r.geometry_ms, r.draw_ms);
     if (!output.empty()) ref::write_png(output, r.image);
     if (!against.empty()) {
       const ref::Image ours = ref::read_png(against);
