@@ -5,10 +5,10 @@
 // cube (Chamberlain et al. 1995) is twelve triangles, by hand.
 #include "objects/lod.h"
 
-#include <vtkCellArray.h>
+#include "objects/polydata.h"
+
 #include <vtkNew.h>
 #include <vtkObject.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataPointSampler.h>
 #include <vtkStaticCellLocator.h>
@@ -27,26 +27,9 @@ namespace terravol::objects {
 
 namespace {
 
-constexpr double kSamplesPerDiagonal = 50.0;  // Lod::error's sample spacing: the box diagonal over this
+using detail::polydata_of;
 
-// The triangles as vtkPolyData (points only: the Hausdorff filter needs no colours).
-vtkSmartPointer<vtkPolyData> polydata_of(const volume::Mesh& m) {
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(static_cast<vtkIdType>(m.vertices.size()));
-  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
-    points->SetPoint(static_cast<vtkIdType>(k), m.vertices[k].x, m.vertices[k].y, m.vertices[k].z);
-  }
-  vtkNew<vtkCellArray> cells;
-  for (std::size_t t = 0; t < m.triangles.size(); t += 3) {
-    const vtkIdType ids[3] = {m.triangles[t], m.triangles[t + 1], m.triangles[t + 2]};
-    cells->InsertNextCell(3, ids);
-  }
-  auto poly = vtkSmartPointer<vtkPolyData>::New();
-  poly->SetPoints(points);
-  poly->SetPolys(cells);
-  return poly;
-}
+constexpr double kSamplesPerDiagonal = 50.0;  // Lod::error's sample spacing: the box diagonal over this
 
 // Points on `surface` about `spacing` apart: its vertices, along its edges, over its triangles.
 vtkSmartPointer<vtkPolyData> samples_of(vtkPolyData* surface, double spacing) {

@@ -164,7 +164,7 @@ Reference reference_image(const fs::path& scene_file, const fs::path& vtp, const
     for (const SliceStyle& sl : styles[v]->slices) append(all, slice(volumes[v], placement, sl));
   }
   r.volume_triangles = all.triangle_count();
-  for (const ObjectStyle& o : scene.objects) append(all, object(o, frame, dem.get()));
+  for (const ObjectStyle& o : scene.objects) append(all, object(o, scene.sun, frame, dem.get()));
   r.object_triangles = all.triangle_count() - r.volume_triangles;
   r.drawn = read_drawn(vtp);
   texture_terrain(r.drawn, frame, stats.window);

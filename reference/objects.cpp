@@ -8,10 +8,13 @@
 #include <GeographicLib/LocalCartesian.hpp>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace terravol::reference {
@@ -46,12 +49,20 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
     const aiMesh& mesh = *scene.mMeshes[node.mMeshes[k]];
     const glm::dvec4 material =
         material_rgba(mesh.mMaterialIndex < scene.mNumMaterials ? scene.mMaterials[mesh.mMaterialIndex] : nullptr);
-    const auto base = static_cast<std::uint32_t>(raw.vertices.size());
+    // A mesh's vertices with the same position and colour are one (docs/scene-file.md: the
+    // model's normals and texture coordinates are not read, so nothing else tells them apart),
+    // which decides where its surface is smooth for the sunlight below.
+    std::map<std::array<float, 7>, std::uint32_t> welded;
+    std::vector<std::uint32_t> index(mesh.mNumVertices);
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-      const aiVector3D p = to_model * mesh.mVertices[v];
+      const aiVector3D& m = mesh.mVertices[v];
+      const aiColor4D c = mesh.HasVertexColors(0) ? mesh.mColors[0][v] : aiColor4D(0, 0, 0, 0);
+      const auto [at, fresh] = welded.try_emplace({m.x, m.y, m.z, c.r, c.g, c.b, c.a}, static_cast<std::uint32_t>(raw.vertices.size()));
+      index[v] = at->second;
+      if (!fresh) continue;
+      const aiVector3D p = to_model * m;
       raw.vertices.emplace_back(p.x, p.y, p.z);
       if (mesh.HasVertexColors(0)) {
-        const aiColor4D& c = mesh.mColors[0][v];
         raw.colors.emplace_back(c.r, c.g, c.b, c.a * material.a);
       } else {
         raw.colors.push_back(material);
@@ -60,7 +71,9 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
-      for (unsigned c = 0; c < 3; ++c) raw.triangles.push_back(base + face.mIndices[c]);
+      const std::uint32_t a = index[face.mIndices[0]], b = index[face.mIndices[1]], c = index[face.mIndices[2]];
+      if (a == b || b == c || a == c) continue;  // collapsed by the weld
+      for (const std::uint32_t corner : {a, b, c}) raw.triangles.push_back(corner);
     }
   }
   for (unsigned k = 0; k < node.mNumChildren; ++k) collect(scene, *node.mChildren[k], to_model, raw);
@@ -78,9 +91,86 @@ Raw read_raw(const std::filesystem::path& file) {
   return raw;
 }
 
+// Vertex normals as objects::sunlit is specified to make them (vtkPolyDataNormals with
+// splitting at kFeatureAngle), written again here: around each vertex its triangles are joined
+// across the edges they share through it where their normals differ by at most the feature
+// angle; each group's normal is the normalised sum of its triangles' unit normals. Returns
+// the mesh with a vertex per (vertex, group) and each triangle's corners renumbered.
+constexpr double kFeatureAngleDeg = 40.0;
+
+struct Lit {
+  std::vector<glm::dvec3> vertices, normals;
+  std::vector<std::size_t> source;  // the input vertex of each
+  std::vector<std::uint32_t> triangles;
+};
+
+Lit split_normals(const std::vector<glm::dvec3>& vertices, const std::vector<std::uint32_t>& triangles) {
+  const std::size_t nt = triangles.size() / 3;
+  std::vector<glm::dvec3> face(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::dvec3 a = vertices[triangles[3 * t]], b = vertices[triangles[3 * t + 1]], c = vertices[triangles[3 * t + 2]];
+    const glm::dvec3 n = glm::cross(b - a, c - a);
+    const double len = glm::length(n);
+    face[t] = len > 0 ? n / len : glm::dvec3(0);
+  }
+  std::vector<std::vector<std::size_t>> around(vertices.size());
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) around[triangles[3 * t + static_cast<std::size_t>(k)]].push_back(t);
+  const double smooth = std::cos(kFeatureAngleDeg * M_PI / 180.0);
+  Lit out;
+  out.triangles = triangles;
+  std::vector<std::size_t> group;
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    const std::vector<std::size_t>& ts = around[v];
+    // Union-find over the triangles around v.
+    std::vector<std::size_t> parent(ts.size());
+    for (std::size_t i = 0; i < ts.size(); ++i) parent[i] = i;
+    const auto root = [&](std::size_t i) {
+      while (parent[i] != i) i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    const auto other_corners = [&](std::size_t t, std::uint32_t out2[2]) {
+      int n = 0;
+      for (int k = 0; k < 3; ++k)
+        if (triangles[3 * t + static_cast<std::size_t>(k)] != v && n < 2) out2[n++] = triangles[3 * t + static_cast<std::size_t>(k)];
+    };
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+      std::uint32_t a[2];
+      other_corners(ts[i], a);
+      for (std::size_t j = i + 1; j < ts.size(); ++j) {
+        std::uint32_t b[2];
+        other_corners(ts[j], b);
+        const bool share = a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1];
+        if (share && glm::dot(face[ts[i]], face[ts[j]]) >= smooth) parent[root(i)] = root(j);
+      }
+    }
+    group.assign(ts.size(), static_cast<std::size_t>(-1));
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+      const std::size_t r = root(i);
+      if (group[r] == static_cast<std::size_t>(-1)) {
+        group[r] = out.vertices.size();
+        out.vertices.push_back(vertices[v]);
+        out.normals.emplace_back(0.0);
+        out.source.push_back(v);
+      }
+      const std::size_t g = group[r];
+      out.normals[g] += face[ts[i]];
+      for (int k = 0; k < 3; ++k) {
+        std::uint32_t& corner = out.triangles[3 * ts[i] + static_cast<std::size_t>(k)];
+        if (triangles[3 * ts[i] + static_cast<std::size_t>(k)] == v) corner = static_cast<std::uint32_t>(g);
+      }
+    }
+  }
+  for (glm::dvec3& n : out.normals) {
+    const double len = glm::length(n);
+    if (len > 0) n /= len;
+  }
+  return out;
+}
+
 }  // namespace
 
-Mesh object(const ObjectStyle& style, const Frame& frame, const Dem* ground) {
+Mesh object(const ObjectStyle& style, const Sun& sun, const Frame& frame, const Dem* ground) {
   const Raw raw = read_raw(style.file);
   std::vector<glm::dvec3> body(raw.vertices.size());
   glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
@@ -102,10 +192,8 @@ Mesh object(const ObjectStyle& style, const Frame& frame, const Dem* ground) {
   const GeographicLib::LocalCartesian enu(style.lat, style.lon, height);
   const double r = style.roll * M_PI / 180, p = style.pitch * M_PI / 180, h = style.heading * M_PI / 180;
 
-  Mesh out;
-  out.triangles = raw.triangles;
-  out.vertices.reserve(body.size());
-  out.colors.reserve(body.size());
+  std::vector<glm::dvec3> placed;
+  placed.reserve(body.size());
   for (std::size_t v = 0; v < body.size(); ++v) {
     const glm::dvec3 b = (body[v] - anchor) * style.scale;
     // Roll about y: the right side (+x) goes down.
@@ -118,9 +206,22 @@ Mesh object(const ObjectStyle& style, const Frame& frame, const Dem* ground) {
     const double north = -pitched.x * std::sin(h) + pitched.y * std::cos(h);
     double lat = 0, lon = 0, alt = 0;
     enu.Reverse(east, north, pitched.z, lat, lon, alt);
-    out.vertices.push_back(frame.to_scene(lat, lon, alt));
-    const glm::dvec4& c = raw.colors[v];
-    out.colors.emplace_back(to_byte(c.r), to_byte(c.g), to_byte(c.b), to_byte(c.a * style.opacity));
+    placed.push_back(frame.to_scene(lat, lon, alt));
+  }
+
+  // Sunlight, two-sided, as the terrain's hillshade: 1 on a face turned up, at most 1.3.
+  const Lit lit = split_normals(placed, raw.triangles);
+  const double az = sun.azimuth_deg * M_PI / 180, el = sun.elevation_deg * M_PI / 180;
+  const glm::dvec3 towards(std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el));
+  Mesh out;
+  out.vertices = lit.vertices;
+  out.triangles = lit.triangles;
+  for (std::size_t v = 0; v < lit.vertices.size(); ++v) {
+    const double s = std::min(sun.ambient + (1 - sun.ambient) * std::abs(glm::dot(lit.normals[v], towards)) / std::sin(el), 1.3);
+    const glm::dvec4& c = raw.colors[lit.source[v]];
+    // The model's colour to bytes first, then lit (the renderer lights the bytes it placed).
+    const auto lit_byte = [&](double x) { return static_cast<std::uint8_t>(std::min(std::lround(to_byte(x) * s), 255L)); };
+    out.colors.emplace_back(lit_byte(c.r), lit_byte(c.g), lit_byte(c.b), to_byte(c.a * style.opacity));
   }
   return out;
 }

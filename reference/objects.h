@@ -23,10 +23,13 @@ namespace terravol::reference {
 //   bounding box), times the scale, turned by roll about y (right side down), pitch about x
 //   (front up) and heading about z (clockwise from north), in that order; then east, north and
 //   up metres about the anchor's point on the WGS84 ellipsoid (GeographicLib::LocalCartesian),
-//   whose height is style.height or the ground's there plus style.agl; then `frame`.
+//   whose height is style.height or the ground's there plus style.agl; then `frame`;
+// - sunlight (objects/shading.h's definition, written again here): each vertex's RGB times
+//   min(ambient + (1 - ambient) |n . sun| / sin(elevation), 1.3), n the normal averaged over
+//   its triangles joined across edges bent by at most 40 degrees (vertices split elsewhere).
 // `ground` may be null when style.height is set. Throws std::runtime_error("FILE: what is
 // wrong") when assimp cannot read the file or it holds no triangles, and what Dem::height
 // throws.
-Mesh object(const ObjectStyle& style, const Frame& frame, const Dem* ground);
+Mesh object(const ObjectStyle& style, const Sun& sun, const Frame& frame, const Dem* ground);
 
 }  // namespace terravol::reference

@@ -88,6 +88,11 @@ Scene read_scene(const fs::path& file) {
         scene.volumes.push_back(std::move(s));
       }
     }
+    if (j.contains("render")) {
+      const json& r = j.at("render");
+      if (r.contains("sun_azimuth")) scene.sun.azimuth_deg = r.at("sun_azimuth").get<double>();
+      if (r.contains("sun_elevation")) scene.sun.elevation_deg = r.at("sun_elevation").get<double>();
+    }
     if (j.contains("objects")) {
       for (const json& o : j.at("objects")) {
         ObjectStyle s;

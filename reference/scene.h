@@ -51,10 +51,17 @@ struct ObjectStyle {
   bool up_z = false;            // "up": "z" (else "y")
 };
 
+// The sun the terrain and the objects are lit by (the scene file's render.sun_azimuth and
+// render.sun_elevation; the renderer's ambient share).
+struct Sun {
+  double azimuth_deg = 315, elevation_deg = 35, ambient = 0.35;
+};
+
 struct Scene {
   std::vector<std::filesystem::path> dems;  // resolved against the scene file's folder
   std::vector<VolumeStyle> volumes;
   std::vector<ObjectStyle> objects;
+  Sun sun;
 };
 
 // Reads a scene file. Isosurfaces without a colour take volume::default_isosurface_color of

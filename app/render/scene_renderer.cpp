@@ -108,7 +108,8 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
     }
   }
   objects_ = scene::ObjectLayer(
-      scene.objects, [this](double lat, double lon) { return ground_height(lat, lon); }, scene_->frame(), options_.lod);
+      scene.objects, [this](double lat, double lon) { return ground_height(lat, lon); }, scene_->frame(), options_.lod,
+      objects::Sunlight{options_.shading.sun_azimuth_deg, options_.shading.sun_elevation_deg, options_.shading.ambient});
   lattice_ = scene::shade_terrain(scene_->cells(), scene_->xs(), scene_->ys(), scene_->z(), scene_->heights(),
                                   options_.shading);
   if (tiled_) {

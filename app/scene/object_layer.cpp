@@ -55,8 +55,8 @@ ObjectLayer::ObjectLayer(ObjectLayer&&) noexcept = default;
 ObjectLayer& ObjectLayer::operator=(ObjectLayer&&) noexcept = default;
 
 ObjectLayer::ObjectLayer(const std::vector<ObjectSpec>& specs, const GroundFunction& ground,
-                         const io::SceneFrame& frame, const objects::LodOptions& lod)
-    : frame_(std::make_unique<io::SceneFrame>(frame)) {
+                         const io::SceneFrame& frame, const objects::LodOptions& lod, const objects::Sunlight& sun)
+    : frame_(std::make_unique<io::SceneFrame>(frame)), sun_(sun) {
   std::map<std::filesystem::path, std::size_t> by_file;
   for (const ObjectSpec& spec : specs) {
     auto [it, fresh] = by_file.try_emplace(spec.file, models_.size());
@@ -141,6 +141,7 @@ const volume::Mesh& ObjectLayer::placed(std::size_t instance, int level) {
   if (in.placed[k].empty()) {
     const volume::Mesh& local = k < m.lods.size() ? m.lods[k].mesh : m.cube;
     in.placed[k] = objects::place(local, in.anchor, in.pose, *frame_, in.spec.opacity);
+    if (k < m.lods.size()) in.placed[k] = objects::sunlit(in.placed[k], sun_);
   }
   return in.placed[k];
 }

@@ -29,6 +29,7 @@
 #include "io/scene_frame.h"
 #include "mrbsp/terrain_tree.h"
 #include "objects/lod.h"
+#include "objects/shading.h"
 #include "volume/geometry.h"
 
 namespace terravol::app::scene {
@@ -66,8 +67,10 @@ class ObjectLayer {
   // merged until update(). Throws io::FormatError("FILE: ...") for a model that cannot be read
   // and std::invalid_argument("FILE: ...") for a pose out of range or an instance more than
   // kMaxObjectMetres across.
+  // Every level of every instance is lit by `sun` (objects::sunlit) once placed; the colour
+  // cube drawn below a pixel is not.
   ObjectLayer(const std::vector<ObjectSpec>& specs, const GroundFunction& ground, const io::SceneFrame& frame,
-              const objects::LodOptions& lod = {});
+              const objects::LodOptions& lod = {}, const objects::Sunlight& sun = {});
   ~ObjectLayer();
   ObjectLayer(ObjectLayer&&) noexcept;
   ObjectLayer& operator=(ObjectLayer&&) noexcept;
@@ -109,6 +112,7 @@ class ObjectLayer {
   ObjectFigures figures_;
   const void* merged_tree_ = nullptr;
   int fixed_level_ = -1;
+  objects::Sunlight sun_;
 };
 
 }  // namespace terravol::app::scene
