@@ -166,6 +166,11 @@ void run_fly(const FlyOptions& o) {
                    {"fps", o.fps},
                    {"threshold", default_threshold},
                    {"samples", o.samples}};
+  // What the command line adds to the scene draws other frames too (absent when not given, as
+  // in manifests written before these keys).
+  if (!o.objects.empty()) manifest["objects"] = o.objects;
+  if (!o.density.empty()) manifest["density"] = o.density;
+  if (o.density_threshold) manifest["density_threshold"] = *o.density_threshold;
   if (tiled) {  // frames of another renderer or sampling are other frames (absent: VTK, as before)
     manifest["renderer"] = scene::engine_name(o.drawn.engine);
     manifest["aa"] = o.drawn.aa;

@@ -195,6 +195,28 @@ TEST(FlyCli, ExistingFramesAreNotOverwrittenWithoutForce) {
   EXPECT_EQ(run_terravol(same + " --force").status, 0);
 }
 
+// Frames drawn with other command-line additions to the scene (an --object, a --density)
+// are other frames: --resume refuses them, as it refuses another size.
+TEST(FlyCli, ResumeRefusesFramesMadeWithOtherObjectsOrDensity) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto path = write_path(dir, flight(0.4));
+  std::ofstream(dir.path() / "mast.obj") << "v -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\nv 0 0 300\n"
+                                            "f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+  const auto frames = dir.path() / "frames";
+  const std::string cmd = "fly " + path.string() + " --fps 5 --size 64x36 -o " + frames.string();
+  const std::string mast = " --object " + (dir.path() / "mast.obj").string() + "@45.12,6.33,0,up=z";
+  ASSERT_EQ(run_terravol(cmd + mast).status, 0);
+  auto r = run_terravol(cmd + mast + " --resume");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run_terravol(cmd + " --resume");  // the same flight without the mast
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("made with another objects"), std::string::npos) << r.err;
+  r = run_terravol(cmd + mast + " --density range=80:150,colormap=viridis,opacity=0.5 --resume");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("made with another density"), std::string::npos) << r.err;
+}
+
 TEST(FlyCli, Mp4HasTheRightFrameCountAndNoTemporaryFileRemains) {
   TERRAVOL_REQUIRE_DISPLAY();
   if (std::system("command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null") != 0) {
