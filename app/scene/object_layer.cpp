@@ -202,6 +202,15 @@ bool ObjectLayer::update(TerrainScene& scene, const mrbsp::Camera& camera, const
   const auto t0 = Clock::now();
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     Instance& in = *instances_[i];
+    if (!visible_) {
+      const bool in_tree = !fresh && in.merged >= 0;
+      in.merged = kHidden;
+      if (in_tree) {
+        ids.push_back(object_surface_id(i));
+        inputs.push_back({});  // an empty surface: taken out
+      }
+      continue;
+    }
     const int k = choose(in, camera, options);
     const volume::Mesh& mesh = placed(i, k);
     figures_.chosen_triangles += mesh.triangle_count();

@@ -59,6 +59,7 @@ struct ObjectFigures {
 
 class ObjectLayer {
  public:
+  static constexpr int kHidden = -2;
   using GroundFunction = std::function<double(double lat, double lon)>;  // metres above the datum
 
   ObjectLayer();
@@ -90,9 +91,13 @@ class ObjectLayer {
   // Every instance at `level` (clamped to its model's last level) from now on; -1: chosen per
   // frame again.
   void set_fixed_level(int level) { fixed_level_ = level; }
+  // Hidden objects are taken out of the tree at the next update() (each instance's surface
+  // emptied) and merged in again, in the levels chosen then, once shown.
+  void set_visible(bool visible) { visible_ = visible; }
+  bool visible() const { return visible_; }
 
-  // The level each instance is merged in (-1 before the first update; levels().size() for the
-  // colour cube).
+  // The level each instance is merged in (-1 before the first update, kHidden while hidden;
+  // levels().size() for the colour cube).
   int level_of(std::size_t instance) const;
   std::size_t model_of(std::size_t instance) const;
   const std::vector<objects::Lod>& levels(std::size_t model) const;
@@ -112,6 +117,7 @@ class ObjectLayer {
   ObjectFigures figures_;
   const void* merged_tree_ = nullptr;
   int fixed_level_ = -1;
+  bool visible_ = true;
   objects::Sunlight sun_;
 };
 

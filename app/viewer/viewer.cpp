@@ -57,6 +57,7 @@
 #include "app/scene/profile_path.h"
 #include "app/scene/terrain_scene.h"
 #include "app/scene/timing.h"
+#include "app/scene/object_layer.h"
 #include "app/scene/volume_layer.h"
 #include "app/viewer/overlay_layout.h"
 #include "density/transfer.h"
@@ -80,6 +81,7 @@ const char* const kViewKeys =
     "G            automatic sliding of the window\n"
     "1 .. 9       show or hide volume N (and select it)\n"
     "X            transmitter markers on / off\n"
+    "B            objects (3D models) on / off\n"
     "[ / ]        move the selected volume's first slice down / up (50 m; 0.01 deg)\n"
     ", / .        lower / raise its first isosurface's level by 2 units\n"
     "E / Shift+E  density: finer / coarser colour cubes (epsilon / or x sqrt 2)\n"
@@ -251,6 +253,7 @@ class Viewer {
   double& threshold() { return threshold_[metric_ == mrbsp::LodMetric::kError ? 1 : 0]; }
   void volume_key(const std::string& key);
   void markers_key();
+  void objects_key();
   void density_key(const std::string& key);
   void write_profile(const io::Geodetic& from, const io::Geodetic& to);
   void record_key();
@@ -537,6 +540,8 @@ void Viewer::key_press(const std::string& key) {
     pipeline_->set_auto_slide(!pipeline_->auto_slide());
   } else if (key == "x") {
     markers_key();
+  } else if (key == "b") {
+    objects_key();
   } else if (key == "e" || key == "E" || key == "o" || key == "O") {
     density_key(key);
   } else if (key == "p") {
@@ -685,6 +690,17 @@ void Viewer::markers_key() {
   std::snprintf(b, sizeof b, "transmitter markers %s: %.0f ms (%zu surfaces merged)", volumes.markers_shown() ? "on" : "off",
                 last_merge_ms_, merge.merged_surfaces);
   message_ = b;
+}
+
+// B: the objects on or off; the next frame takes them out of the tree or merges them again.
+void Viewer::objects_key() {
+  scene::ObjectLayer& objects = pipeline_->objects();
+  if (objects.size() == 0) {
+    message_ = "no objects (give --object or a scene file's \"objects\")";
+    return;
+  }
+  objects.set_visible(!objects.visible());
+  message_ = std::string("objects ") + (objects.visible() ? "on" : "off");
 }
 
 // E, Shift+E: epsilon of the colour cubes (the next frame refines with it); O, Shift+O: the
@@ -1144,6 +1160,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
                 {"merge_ms", merge.merge_ms},
                 {"merged_surfaces", merge.merged_surfaces}};
   j["markers"] = volumes.markers_shown();
+  j["objects"] = pipeline_->objects().visible();
   j["last_merge_ms"] = last_merge_ms_;
   j["message"] = message_;
   if (pick_) {

@@ -719,6 +719,40 @@ TEST(ViewCli, XTogglesTheTransmitterMarkersMergingOnlyTheirSurface) {
   EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
 
+// B takes the objects out of the picture and brings them back: a red tower 3 km ahead.
+TEST(ViewCli, BTogglesTheObjects) {
+  TERRAVOL_REQUIRE_XDOTOOL();
+  test::TempDir dir;
+  const auto obj = dir.path() / "tower.obj";
+  std::ofstream(dir.path() / "tower.mtl") << "newmtl red\nKd 1 0 0\n";
+  std::ofstream(obj) << "mtllib tower.mtl\nusemtl red\n"
+                        "v -150 -150 0\nv 150 -150 0\nv 150 150 0\nv -150 150 0\n"
+                        "v -150 -150 600\nv 150 -150 600\nv 150 150 600\nv -150 150 600\n"
+                        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  Viewer v(bundled_dem() + " --agl --camera 45.47,6.47,400,45,-8 --object " + obj.string() + "@45.49,6.495,0,up=z" + kSmall);
+  ASSERT_TRUE(v.start());
+  const auto red = [](const test::Image& img) {
+    std::size_t n = 0;
+    for (const auto& p : img.pixels) n += p[0] > 60 && p[1] < 30 && p[2] < 30;
+    return n;
+  };
+  json s = v.settle();
+  EXPECT_TRUE(s["objects"].get<bool>());
+  const std::size_t shown = red(v.screenshot());
+  EXPECT_GT(shown, 100u) << "the tower, lit on its faces";
+  v.tap("b");
+  s = v.settle();
+  EXPECT_FALSE(s["objects"].get<bool>());
+  EXPECT_NE(s["message"].get<std::string>().find("objects off"), std::string::npos) << s["message"];
+  EXPECT_EQ(red(v.screenshot()), 0u);
+  v.tap("b");
+  s = v.settle();
+  EXPECT_TRUE(s["objects"].get<bool>());
+  EXPECT_EQ(red(v.screenshot()), shown);
+  v.xdo("key q");
+  EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
+}
+
 // Two Shift-clicks, a quarter of the window left and right of the centre looking straight
 // down: the link between the two picked points is drawn over the terrain in the path's
 // colours and its plot is written where --profile-plot says. The plot and the loss are what
