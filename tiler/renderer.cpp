@@ -474,6 +474,13 @@ namespace {
 
 // A band's pixels being accumulated: the colour sums, transmittance and sample counts of the
 // pixels of one band (rows from the bottom), and its transmittance classes.
+// Transmittance classes closer than this join, at their samples' mean (which keeps the sum of
+// the pixel's transmittances, so a later fragment over all of their samples is weighted
+// exactly; one over some of them is off by less than this). A density's colour-box faces split
+// a pixel at every face edge into classes that equal transmittances alone never joined: at 8 x 8
+// samples the bench's 6 km density (2.5 million face triangles at 480x270) made 14 million
+// splits and took 17-27 s to tile, 1.8 s with this join, no pixel more than 1/255 away.
+constexpr float kJoinTolerance = 1.0f / 256.0f;
 struct Accumulator {
   Pixel* px;
   std::size_t n_pixels;
@@ -558,6 +565,11 @@ struct Accumulator {
       for (std::int32_t* other = &cl.next; *other >= 0;) {
         Class& o = classes[static_cast<std::size_t>(*other)];
         if (o.t == cl.t) {
+          cl.mask |= o.mask & open;
+          *other = o.next;
+        } else if (std::abs(o.t - cl.t) <= kJoinTolerance && (o.mask & open)) {
+          const auto a = static_cast<float>(popcount(cl.mask)), b = static_cast<float>(popcount(o.mask & open));
+          cl.t = (cl.t * a + o.t * b) / (a + b);
           cl.mask |= o.mask & open;
           *other = o.next;
         } else {

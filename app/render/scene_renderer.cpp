@@ -82,9 +82,6 @@ SceneRenderer::SceneRenderer(io::Mosaic mosaic, const scene::SceneSpec& scene, c
       throw std::invalid_argument("the tiler draws filled triangles in the tree's order only (--order bsp, no "
                                   "--wireframe or --lod-colors)");
     }
-    for (const scene::VolumeSpec& v : scene.volumes) {
-      if (v.density) throw std::invalid_argument("the tiler does not draw densities (--renderer vtk draws them)");
-    }
     options_.tiler.width = settings_.width;
     options_.tiler.height = settings_.height;
     tiled_ = std::make_unique<TiledRenderer>(options_.tiler);  // throws for bad settings before the scene is read
@@ -312,11 +309,12 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
                                      options_.near_plane > 0 ? options_.near_plane : scene::near_plane_for(clearance));
   const auto sky = settings_.gradient ? scene::sky_gradient(pose.pitch_deg, fov_y_deg)
                                       : std::array<scene::Rgb, 2>{settings_.background, settings_.background};
-  // The density's cells of this view (none for the tiler, which does not draw densities); the
-  // far plane holds them as it holds the window and the merged surfaces (they may lie beyond).
+  // The density's cells of this view (refined for the output's pixels, whatever draws them);
+  // the far plane holds them as it holds the window and the merged surfaces (they may lie
+  // beyond).
   auto t0 = Clock::now();
   boxes_.clear();
-  if (!tiled_) volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
+  volumes_.density_boxes(camera_, density_options_, boxes_, stats.density);
   double far = scene_->far_plane(camera_.eye);
   if (!boxes_.empty()) {
     double farthest = 0.0;
@@ -342,7 +340,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   t0 = Clock::now();
   if (tiled_) {
     const int aa = tiled_->settings().aa;
-    scene_->tree().traverse(tiled_traversal_camera(camera_, traversal, aa), tiled_traversal(traversal, aa), frame_);
+    scene_->tree().traverse(tiled_traversal_camera(camera_, traversal, aa), tiled_traversal(traversal, aa), frame_, boxes_);
   } else {
     scene_->tree().traverse(camera_, traversal, frame_, boxes_);
   }

@@ -66,13 +66,28 @@ double TiledRenderer::draw(const mrbsp::TerrainTree& tree, const scene::TerrainS
                            const scene::Rgb& sky_top, double haze_distance, const scene::Rgb& haze_color) {
   tiler::SceneColors colors;
   colors.positions = tree.positions();
+  colors.merged_colors = tree.merged_colors();
+  if (!frame.transient_positions.empty()) {
+    // The frame's own vertices (colour-box faces, from transient_base = positions().size()) go
+    // after the tree's as more merged vertices: a copy of the tree's per frame (12 and 4 bytes
+    // a vertex), which an export renderer can afford.
+    if (frame.transient_base != tree.positions().size()) {
+      throw std::invalid_argument("TiledRenderer::draw: the frame's own vertices start at " + std::to_string(frame.transient_base) +
+                                  ", after " + std::to_string(tree.positions().size()) + " vertices of the tree");
+    }
+    positions_.assign(tree.positions().begin(), tree.positions().end());
+    positions_.insert(positions_.end(), frame.transient_positions.begin(), frame.transient_positions.end());
+    merged_colors_.assign(tree.merged_colors().begin(), tree.merged_colors().end());
+    merged_colors_.insert(merged_colors_.end(), frame.transient_colors.begin(), frame.transient_colors.end());
+    colors.positions = positions_;
+    colors.merged_colors = merged_colors_;
+  }
   colors.lattice_side = tree.cells() + 1;
   // Rgba is four bytes (std::array<std::uint8_t, 4>): the lattice's colours are read as bytes.
   static_assert(sizeof(scene::Rgba) == 4);
   colors.texture = std::span(reinterpret_cast<const std::uint8_t*>(lattice.rgba.data()), lattice.rgba.size() * 4);
   colors.merged_base = tree.merged_base();
   colors.wall_color = glm::u8vec4(scene::kWallColor[0], scene::kWallColor[1], scene::kWallColor[2], 255);
-  colors.merged_colors = tree.merged_colors();
   tiler::Look look;
   look.sky_bottom = glm::dvec3(sky_bottom[0], sky_bottom[1], sky_bottom[2]);
   look.sky_top = glm::dvec3(sky_top[0], sky_top[1], sky_top[2]);

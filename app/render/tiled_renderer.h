@@ -41,7 +41,11 @@ class TiledRenderer {
   // Draws `frame` (a front-to-back traversal of `tree`, tiled_traversal) for `camera` (the
   // output's size) with the lattice colours `lattice` (shade_terrain: one RGBA per sample,
   // the texture), the sky gradient (bottom, top; equal for a uniform background) and the haze
-  // (distance in metres, 0: none), then lays the legend over it. Returns wall milliseconds.
+  // (distance in metres, 0: none), then lays the legend over it. The frame's colour-box faces
+  // (a density: Frame::transient_positions and transient_colors from transient_base) are
+  // drawn as merged polygons, composited in float like every translucent polygon. Returns
+  // wall milliseconds. Throws std::invalid_argument when the frame's transient_base is not
+  // the tree's vertex count.
   double draw(const mrbsp::TerrainTree& tree, const scene::TerrainShading& lattice, const mrbsp::Frame& frame,
               const mrbsp::Camera& camera, double far_plane, const scene::Rgb& sky_bottom, const scene::Rgb& sky_top,
               double haze_distance, const scene::Rgb& haze_color);
@@ -63,6 +67,8 @@ class TiledRenderer {
   tiler::Renderer tiler_;
   tiler::Stats stats_;
   std::vector<std::uint8_t> rgb_;
+  std::vector<glm::vec3> positions_;        // the tree's vertices and a frame's own, when it has some
+  std::vector<glm::u8vec4> merged_colors_;  // the tree's merged colours and the frame's own
   std::optional<RgbaImage> legend_;
   std::vector<std::pair<glm::dvec3, RgbaImage>> labels_;  // anchor (scene frame), text
 };
