@@ -112,6 +112,15 @@ app::scene::CameraPose view_of(const app::render::SceneRenderer& scene, const de
 
 double density_frame_ms(const app::render::FrameStats& s) { return s.density_ms + frame_ms(s); }
 
+// One frame of `scene`, its wall time appended to `wall`.
+app::render::FrameStats timed_render(app::render::SceneRenderer& scene, const app::scene::CameraPose& pose,
+                                     const mrbsp::TraversalOptions& traversal, std::vector<double>& wall) {
+  const auto t0 = Clock::now();
+  const app::render::FrameStats s = scene.render(pose, false, 45.0, traversal);
+  wall.push_back(ms_since(t0));
+  return s;
+}
+
 // The cells a refinement with `options` draws from `pose` (the eye at pose.alt above the
 // datum), counted without drawing them: views whose frames would not fit this machine's memory
 // are left out (7.5 million cells took over 24 GB with their faces' vertices).
@@ -161,15 +170,11 @@ json lattice_series(const BenchConfig& c, const Terrain& terrain, const std::fil
     app::render::FrameStats sa, sb;
     for (int r = 0; r < c.repeats; ++r) {
       scene.set_density_options(octree);
-      auto t0 = Clock::now();
-      sa = scene.render(pose, false, 45.0, traversal);
-      wall_a.push_back(ms_since(t0));
+      sa = timed_render(scene, pose, traversal, wall_a);
       a.push_back(density_frame_ms(sa));
       if (draw_every) {
         scene.set_density_options(every);
-        t0 = Clock::now();
-        sb = scene.render(pose, false, 45.0, traversal);
-        wall_b.push_back(ms_since(t0));
+        sb = timed_render(scene, pose, traversal, wall_b);
         b.push_back(density_frame_ms(sb));
       }
     }
@@ -268,9 +273,7 @@ json density_suite(const BenchConfig& c, const Terrain& terrain) {
     std::vector<double> t, wall, change;
     app::render::FrameStats s;
     for (int r = 0; r < c.repeats; ++r) {
-      const auto t0 = Clock::now();
-      s = scene.render(pose, false, 45.0, traversal);
-      wall.push_back(ms_since(t0));
+      s = timed_render(scene, pose, traversal, wall);
       t.push_back(density_frame_ms(s));
     }
     // A transfer-function change (the opacity, alternately up and back) to the finished frame.

@@ -152,7 +152,7 @@ Reference reference_image(const fs::path& scene_file, const fs::path& vtp, const
   }
   std::unique_ptr<Dem> dem;
   if (ground) {
-    if (scene.dems.empty()) throw std::runtime_error(scene_file.string() + ": volumes need the ground and the scene names no DEM");
+    if (scene.dems.empty()) throw std::runtime_error(scene_file.string() + ": volumes or objects need the ground and the scene names no DEM");
     dem = std::make_unique<Dem>(Dem::read(scene.dems, box));
   }
 

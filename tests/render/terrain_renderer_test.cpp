@@ -206,6 +206,18 @@ TEST(TerrainRenderer, LongRunsOfMergedPiecesDrawnWithoutTheTextureGiveTheSameIma
   EXPECT_NEAR(blended[2], 128, 2);
 }
 
+// Appends a colour-box face to `f` (after its transient_base): the square over the two
+// squares' x and y at height z, in `colour`.
+void add_face(mrbsp::Frame& f, float z, glm::u8vec4 colour) {
+  const std::uint32_t b = f.transient_base + static_cast<std::uint32_t>(f.transient_positions.size());
+  for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
+    f.transient_positions.emplace_back(x, y, z);
+    f.transient_colors.push_back(colour);
+  }
+  f.indices.insert(f.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+  f.level.insert(f.level.end(), {mrbsp::kBoxLevel, mrbsp::kBoxLevel});
+}
+
 // Colour-box faces (a density) are many faint layers over a pixel. 300 black faces of opacity
 // 1/255 over the white far square leave 255 (254/255)^300 = 78.7 in exact arithmetic; blended
 // into 8 bits, every step rounds, and the colour stops moving once a step is under half a unit
@@ -220,16 +232,7 @@ TEST(TerrainRenderer, ManyFaintColourBoxFacesBlendAsInExactArithmetic) {
   const double exact = 255.0 * std::pow(254.0 / 255.0, kLayers);
   mrbsp::Frame boxes = frame_of({4, 5, 6, 4, 6, 7});  // the white square at z = 0
   boxes.transient_base = static_cast<std::uint32_t>(s.positions.size());
-  for (int k = 0; k < kLayers; ++k) {
-    const float z = 0.5f + 4.0f * static_cast<float>(k) / kLayers;
-    const std::uint32_t b = boxes.transient_base + static_cast<std::uint32_t>(boxes.transient_positions.size());
-    for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
-      boxes.transient_positions.emplace_back(x, y, z);
-      boxes.transient_colors.emplace_back(0, 0, 0, 1);
-    }
-    boxes.indices.insert(boxes.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
-    boxes.level.insert(boxes.level.end(), {mrbsp::kBoxLevel, mrbsp::kBoxLevel});
-  }
+  for (int k = 0; k < kLayers; ++k) add_face(boxes, 0.5f + 4.0f * static_cast<float>(k) / kLayers, {0, 0, 0, 1});
   TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));
   renderer.set_camera(s.camera, 100.0);
   renderer.set_frame(boxes);
@@ -272,15 +275,7 @@ TEST(TerrainRenderer, AFewMoreFaceVerticesFitTheTailAndDrawTheirOwnColours) {
   const auto faces = [&](int quads, glm::u8vec4 colour) {
     mrbsp::Frame f = frame_of({4, 5, 6, 4, 6, 7});
     f.transient_base = static_cast<std::uint32_t>(s.positions.size());
-    for (int k = 0; k < quads; ++k) {
-      const std::uint32_t b = f.transient_base + static_cast<std::uint32_t>(f.transient_positions.size());
-      for (auto [x, y] : {std::pair{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}}) {
-        f.transient_positions.emplace_back(x, y, 1.0f);
-        f.transient_colors.push_back(colour);
-      }
-      f.indices.insert(f.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
-      f.level.insert(f.level.end(), {mrbsp::kBoxLevel, mrbsp::kBoxLevel});
-    }
+    for (int k = 0; k < quads; ++k) add_face(f, 1.0f, colour);
     return f;
   };
   TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));

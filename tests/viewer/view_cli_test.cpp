@@ -685,6 +685,13 @@ std::size_t pixels_near(const test::Image& img, std::initializer_list<test::Rgb8
   return n;
 }
 
+// Pixels redder than red_above with green and blue under the other two bounds.
+std::size_t reddish(const test::Image& img, int red_above, int green_below, int blue_below) {
+  std::size_t n = 0;
+  for (const auto& p : img.pixels) n += p[0] > red_above && p[1] < green_below && p[2] < blue_below;
+  return n;
+}
+
 // X hides the transmitter's red mast and shows it again, re-merging the marker surface alone.
 TEST(ViewCli, XTogglesTheTransmitterMarkersMergingOnlyTheirSurface) {
   TERRAVOL_REQUIRE_XDOTOOL();
@@ -695,11 +702,7 @@ TEST(ViewCli, XTogglesTheTransmitterMarkersMergingOnlyTheirSurface) {
   // test's markers); an isosurface too, which the toggle must leave alone.
   Viewer v(bundled_dem() + " --agl --camera 45.47,6.47,400,45,-8 --volume " + vdb.string() + " --iso 150" + kSmall);
   ASSERT_TRUE(v.start());
-  const auto red = [](const test::Image& img) {
-    std::size_t n = 0;
-    for (const auto& p : img.pixels) n += p[0] > 180 && p[1] < 80 && p[2] < 90;
-    return n;
-  };
+  const auto red = [](const test::Image& img) { return reddish(img, 180, 80, 90); };
   json s = v.settle();
   EXPECT_TRUE(s["markers"].get<bool>());
   const std::size_t shown = red(v.screenshot());
@@ -731,11 +734,7 @@ TEST(ViewCli, BTogglesTheObjects) {
                         "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
   Viewer v(bundled_dem() + " --agl --camera 45.47,6.47,400,45,-8 --object " + obj.string() + "@45.49,6.495,0,up=z" + kSmall);
   ASSERT_TRUE(v.start());
-  const auto red = [](const test::Image& img) {
-    std::size_t n = 0;
-    for (const auto& p : img.pixels) n += p[0] > 60 && p[1] < 30 && p[2] < 30;
-    return n;
-  };
+  const auto red = [](const test::Image& img) { return reddish(img, 60, 30, 30); };
   json s = v.settle();
   EXPECT_TRUE(s["objects"].get<bool>());
   const std::size_t shown = red(v.screenshot());
