@@ -83,6 +83,10 @@ struct TraversalOptions {
   bool occlusion_adaptive = true;
   bool crack_fills = true;      // balance neighbours within one level and fill the cracks between
                                 // them (off for wireframe views, where fills only clutter)
+  // The last pass (the drawn cells and small BSPs written out as triangles) runs in parallel
+  // chunks of the draw order, joined in that order, when the frame is estimated to draw at
+  // least this many triangles and has no colour boxes; the triangles are the same either way.
+  std::size_t parallel_min_triangles = 32768;
 };
 
 // Frame::level values other than terrain levels (0 coarsest, levels-1 finest).
@@ -178,6 +182,14 @@ struct Frame {
   };
   std::vector<OutsideOrder> outside_places_;
   std::vector<std::uint64_t> leaf_stack_;
+  // The last pass's chunks after the first (which writes into indices and level directly).
+  struct EmitChunk {
+    std::vector<std::uint32_t> indices;
+    std::vector<std::int8_t> level;
+    std::vector<std::uint64_t> stack;
+    std::size_t triangles = 0, crack_triangles = 0;
+  };
+  std::vector<EmitChunk> chunks_;
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found

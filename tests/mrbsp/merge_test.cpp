@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <random>
 
 #include "mrbsp/terrain_tree.h"
@@ -164,6 +165,37 @@ TEST(Merge, ALargeSurfaceSentInChunksDrawsItsWholeVisibleAreaInOrder) {
     tree.traverse(cam, o, f);
     EXPECT_EQ(order_violations(tree, f, eye, 100, rng, true), 0) << "trial " << trial;
   }
+}
+
+// The last pass of a traversal writes large frames in parallel chunks of the draw order and
+// joins them: from random eyes, with and without culling, back to front and front to back,
+// the chunked frame is the serial one triangle for triangle, with the same crack fills.
+TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
+  std::mt19937 rng(19);
+  TestWindow w(16, [](int, int) { return 0.0f; });
+  TerrainTree tree = hilly_tree(rng, w);
+  Soup soup = random_triangles(rng, 600, {-100.0, 1700.0, -50.0, 500.0, 40.0});
+  tree.merge(soup.v, soup.c, soup.t);
+  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(50.0, 900.0), dir(-1.0, 1.0);
+  Frame serial, chunked;
+  std::size_t merged = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.4 + 0.3 * dir(rng)});
+    TraversalOptions o;
+    o.cull = trial % 2 == 0;
+    o.front_to_back = trial % 3 == 2;
+    o.threshold_px = 1.0f + static_cast<float>(trial % 4);
+    o.parallel_min_triangles = std::numeric_limits<std::size_t>::max();
+    tree.traverse(c, o, serial);
+    o.parallel_min_triangles = 0;
+    tree.traverse(c, o, chunked);
+    ASSERT_EQ(chunked.indices, serial.indices) << "trial " << trial;
+    EXPECT_EQ(chunked.level, serial.level) << "trial " << trial;
+    EXPECT_EQ(chunked.crack_triangles, serial.crack_triangles) << "trial " << trial;
+    merged += static_cast<std::size_t>(std::count(serial.level.begin(), serial.level.end(), kMergedLevel));
+  }
+  EXPECT_GT(merged, 600u);
 }
 
 // Culling by content boxes: from cameras inside and beside the merged triangles, low over the
