@@ -5,8 +5,19 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <vtkImageData.h>
+#include <vtkImageReader2.h>
+#include <vtkImageReader2Factory.h>
+#include <vtkJPEGReader.h>
+#include <vtkPNGReader.h>
+#include <vtkSmartPointer.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <unordered_map>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -19,9 +30,11 @@ namespace {
 std::uint8_t byte_of(float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
 // The material's colour and opacity: its diffuse colour, else its glTF base colour, else
-// assimp's default grey (0.6); alpha the colour's times the opacity.
-aiColor4D material_color(const aiMaterial* m) {
-  aiColor4D c(0.6f, 0.6f, 0.6f, 1.0f);
+// assimp's default grey (0.6), or white when the material has a texture; alpha the colour's times
+// the opacity.
+aiColor4D material_color(const aiMaterial* m, bool textured) {
+  const float grey = textured ? 1.0f : 0.6f;  // a textured material's colour factor is 1 by default (glTF)
+  aiColor4D c(grey, grey, grey, 1.0f);
   if (m == nullptr) return c;
   if (m->Get(AI_MATKEY_COLOR_DIFFUSE, c) != AI_SUCCESS) m->Get(AI_MATKEY_BASE_COLOR, c);
   float opacity = 1.0f;
@@ -35,6 +48,127 @@ std::string one_line(std::string s) {
   std::replace(s.begin(), s.end(), '\r', ' ');
   while (!s.empty() && s.back() == ' ') s.pop_back();
   return s.empty() ? "assimp could not read it" : s;
+}
+
+// A texture as RGBA bytes, row 0 at the bottom (VTK's order and assimp's: texture coordinate
+// v = 0 is the image's last row).
+struct Texture {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+
+  // Bilinear, repeating (glTF's default sampler, and OBJ's), 0..1 per channel.
+  std::array<float, 4> sample(float u, float v) const {
+    const float x = u * static_cast<float>(width) - 0.5f, y = v * static_cast<float>(height) - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const float ax = x - fx, ay = y - fy;
+    const auto wrap = [](long i, int n) { return static_cast<std::size_t>(((i % n) + n) % n); };
+    const long x0 = static_cast<long>(fx), y0 = static_cast<long>(fy);
+    std::array<float, 4> out{};
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        const float w = (dx ? ax : 1.0f - ax) * (dy ? ay : 1.0f - ay);
+        const std::size_t at = 4 * (wrap(y0 + dy, height) * static_cast<std::size_t>(width) + wrap(x0 + dx, width));
+        for (int c = 0; c < 4; ++c) out[static_cast<std::size_t>(c)] += w * static_cast<float>(rgba[at + static_cast<std::size_t>(c)]) / 255.0f;
+      }
+    return out;
+  }
+};
+
+// The image a VTK reader decodes, as RGBA bytes (grey, grey and alpha, RGB or RGBA; 8 or 16
+// bits). Empty when it reads nothing. Throws for more than kMaxTexturePixels pixels, checked
+// from the header before the pixels are read.
+std::optional<Texture> decode(vtkImageReader2& reader, const std::string& source, const std::string& name) {
+  reader.UpdateInformation();
+  const int* extent = reader.GetDataExtent();
+  const std::int64_t w = std::int64_t{extent[1]} - extent[0] + 1, h = std::int64_t{extent[3]} - extent[2] + 1;
+  if (w <= 0 || h <= 0) return std::nullopt;
+  if (static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h) > kMaxTexturePixels) {
+    throw io::FormatError(source, "texture '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) +
+                                      " pixels, more than 16384x16384");
+  }
+  reader.Update();
+  vtkImageData* image = reader.GetOutput();
+  const int* dims = image->GetDimensions();
+  const int n = image->GetNumberOfScalarComponents();
+  const int type = image->GetScalarType();
+  if (dims[0] != w || dims[1] != h || n < 1 || n > 4 || (type != VTK_UNSIGNED_CHAR && type != VTK_UNSIGNED_SHORT)) return std::nullopt;
+  Texture t;
+  t.width = static_cast<int>(w);
+  t.height = static_cast<int>(h);
+  const std::size_t pixels = static_cast<std::size_t>(w * h);
+  t.rgba.resize(4 * pixels);
+  const void* data = image->GetScalarPointer();
+  for (std::size_t p = 0; p < pixels; ++p) {
+    std::array<std::uint8_t, 4> in{0, 0, 0, 255};
+    for (int c = 0; c < n; ++c) {
+      const std::size_t at = p * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
+      in[static_cast<std::size_t>(c)] = type == VTK_UNSIGNED_CHAR ? static_cast<const std::uint8_t*>(data)[at]
+                                                                  : static_cast<std::uint8_t>(static_cast<const std::uint16_t*>(data)[at] >> 8);
+    }
+    const bool grey = n <= 2;
+    const std::array<std::uint8_t, 4> rgba{in[0], grey ? in[0] : in[1], grey ? in[0] : in[2], n == 2 ? in[1] : n == 4 ? in[3] : std::uint8_t{255}};
+    std::copy(rgba.begin(), rgba.end(), t.rgba.begin() + static_cast<std::ptrdiff_t>(4 * p));
+  }
+  return t;
+}
+
+// The material's diffuse (or glTF base-colour) texture and the texture-coordinate set it uses:
+// embedded in the file (compressed PNG or JPEG, or raw texels), or a file beside the model.
+// Empty when the material names none; `missing` gets the name of one that cannot be read.
+std::optional<Texture> material_texture(const aiScene& scene, const aiMaterial& m, const std::filesystem::path& model,
+                                        const std::string& source, unsigned& channel, std::vector<std::string>& missing) {
+  aiString path;
+  channel = 0;
+  if (m.GetTexture(aiTextureType_BASE_COLOR, 0, &path, nullptr, &channel) != AI_SUCCESS &&
+      m.GetTexture(aiTextureType_DIFFUSE, 0, &path, nullptr, &channel) != AI_SUCCESS) {
+    return std::nullopt;
+  }
+  const std::string name = path.C_Str();
+  std::optional<Texture> texture;
+  if (const aiTexture* embedded = scene.GetEmbeddedTexture(path.C_Str())) {
+    if (embedded->mHeight == 0) {  // a compressed file in memory, mWidth bytes
+      const std::string hint = embedded->achFormatHint;
+      vtkSmartPointer<vtkImageReader2> reader;
+      if (hint == "png") reader = vtkSmartPointer<vtkPNGReader>::New();
+      if (hint == "jpg" || hint == "jpeg") reader = vtkSmartPointer<vtkJPEGReader>::New();
+      if (reader) {
+        reader->SetMemoryBuffer(embedded->pcData);
+        reader->SetMemoryBufferLength(embedded->mWidth);
+        texture = decode(*reader, source, name);
+      }
+    } else if (static_cast<std::uint64_t>(embedded->mWidth) * embedded->mHeight <= kMaxTexturePixels) {
+      // Raw texels, the first row at the top.
+      Texture t;
+      t.width = static_cast<int>(embedded->mWidth);
+      t.height = static_cast<int>(embedded->mHeight);
+      t.rgba.resize(4 * static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height));
+      for (int y = 0; y < t.height; ++y)
+        for (int x = 0; x < t.width; ++x) {
+          const aiTexel& texel = embedded->pcData[static_cast<std::size_t>(t.height - 1 - y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x)];
+          const std::size_t at = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x));
+          t.rgba[at] = texel.r;
+          t.rgba[at + 1] = texel.g;
+          t.rgba[at + 2] = texel.b;
+          t.rgba[at + 3] = texel.a;
+        }
+      texture = std::move(t);
+    }
+  } else {
+    std::string relative = name;
+    std::replace(relative.begin(), relative.end(), '\\', '/');
+    const std::filesystem::path file = model.parent_path() / relative;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(file, ec)) {
+      vtkSmartPointer<vtkImageReader2> reader;
+      reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(file.string().c_str()));
+      if (reader) {
+        reader->SetFileName(file.string().c_str());
+        texture = decode(*reader, source, name);
+      }
+    }
+  }
+  if (!texture && std::find(missing.begin(), missing.end(), name) == missing.end()) missing.push_back(name);
+  return texture;
 }
 
 struct Collector {
@@ -51,31 +185,55 @@ struct Collector {
   void mesh(const aiMesh* a, const aiMatrix4x4& m) {
     if ((a->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) return;
     volume::Mesh& out = model.mesh;
-    const std::size_t base = out.vertices.size();
-    const aiColor4D mc = material_color(a->mMaterialIndex < scene->mNumMaterials ? scene->mMaterials[a->mMaterialIndex] : nullptr);
+    const aiMaterial* material = a->mMaterialIndex < scene->mNumMaterials ? scene->mMaterials[a->mMaterialIndex] : nullptr;
     const bool per_vertex = a->HasVertexColors(0);
     model.vertex_colors = model.vertex_colors || per_vertex;
+    unsigned channel = 0;
+    std::optional<Texture> texture;
+    if (material != nullptr) texture = material_texture(*scene, *material, model.file, source, channel, model.missing_textures);
+    if (texture && !a->HasTextureCoords(channel)) texture.reset();
+    if (texture) ++model.textured_meshes;
+    const aiColor4D mc = material_color(material, texture.has_value());
     std::size_t faces = 0;
     for (unsigned f = 0; f < a->mNumFaces; ++f) faces += a->mFaces[f].mNumIndices == 3 ? 1 : 0;
     if (faces == 0) return;
     if (out.triangle_count() + faces > kMaxModelTriangles) {
       throw io::FormatError(source, "more than " + std::to_string(kMaxModelTriangles) + " triangles; too large to place");
     }
+    // Vertices with the same position and colour are one (texture coordinates told them apart
+    // while the texture was sampled).
+    std::unordered_map<std::string, std::uint32_t> welded;  // key: the position's floats and the colour's bytes
+    std::vector<std::uint32_t> index(a->mNumVertices);
     for (unsigned v = 0; v < a->mNumVertices; ++v) {
       const aiVector3D p = m * a->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
         throw io::FormatError(source, "vertex " + std::to_string(v) + " of mesh '" + a->mName.C_Str() + "' is not finite");
       }
+      aiColor4D c = per_vertex ? a->mColors[0][v] : mc;
+      if (per_vertex) c.a *= mc.a;
+      if (texture) {
+        const aiVector3D& uv = a->mTextureCoords[channel][v];
+        const std::array<float, 4> t = texture->sample(uv.x, uv.y);
+        c = aiColor4D(c.r * t[0], c.g * t[1], c.b * t[2], c.a * t[3]);
+      }
+      const std::array<std::uint8_t, 4> rgba{byte_of(c.r), byte_of(c.g), byte_of(c.b), byte_of(c.a)};
+      const aiVector3D& at = a->mVertices[v];
+      std::string key(16, '\0');
+      const float xyz[3] = {at.x, at.y, at.z};
+      std::memcpy(key.data(), xyz, 12);
+      std::memcpy(key.data() + 12, rgba.data(), 4);
+      const auto [it, fresh] = welded.try_emplace(std::move(key), static_cast<std::uint32_t>(out.vertices.size()));
+      index[v] = it->second;
+      if (!fresh) continue;
       out.vertices.emplace_back(p.x, p.y, p.z);
-      const aiColor4D c = per_vertex ? a->mColors[0][v] : mc;
-      out.colors.emplace_back(byte_of(c.r), byte_of(c.g), byte_of(c.b), byte_of(per_vertex ? c.a * mc.a : c.a));
+      out.colors.emplace_back(rgba[0], rgba[1], rgba[2], rgba[3]);
     }
     for (unsigned f = 0; f < a->mNumFaces; ++f) {
       const aiFace& face = a->mFaces[f];
       if (face.mNumIndices != 3) continue;
-      const unsigned i = face.mIndices[0], j = face.mIndices[1], k = face.mIndices[2];
+      const std::uint32_t i = index[face.mIndices[0]], j = index[face.mIndices[1]], k = index[face.mIndices[2]];
       if (i == j || j == k || i == k) continue;
-      for (const unsigned x : {i, j, k}) out.triangles.push_back(static_cast<std::uint32_t>(base + x));
+      for (const std::uint32_t x : {i, j, k}) out.triangles.push_back(x);
     }
     ++model.meshes;
   }
@@ -95,12 +253,11 @@ Model read_model(const std::filesystem::path& file) {
   if (bytes == 0) throw io::FormatError(source, "empty file");
 
   Assimp::Importer importer;
-  // Normals, texture coordinates and the rest are not used: removed first, so that joining
-  // identical vertices joins by position and colour.
+  // Normals and the rest are not used: removed first. Texture coordinates and embedded
+  // textures are kept for the textures' colours.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                                          aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS |
-                                                          aiComponent_ANIMATIONS | aiComponent_CAMERAS |
-                                                          aiComponent_LIGHTS | aiComponent_TEXTURES);
+                                                          aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                                          aiComponent_CAMERAS | aiComponent_LIGHTS);
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene = nullptr;
   try {

@@ -7,6 +7,13 @@
 
 #include <GeographicLib/LocalCartesian.hpp>
 
+#include <vtkImageData.h>
+#include <vtkImageReader2.h>
+#include <vtkImageReader2Factory.h>
+#include <vtkJPEGReader.h>
+#include <vtkPNGReader.h>
+#include <vtkSmartPointer.h>
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
@@ -15,6 +22,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 namespace terravol::reference {
@@ -30,8 +38,87 @@ struct Raw {
   std::vector<std::uint32_t> triangles;
 };
 
-glm::dvec4 material_rgba(const aiMaterial* material) {
-  aiColor4D c(0.6f, 0.6f, 0.6f, 1.0f);
+// A decoded texture: texel (x, y) at rgba[4 * (y * width + x)], y = 0 the image's bottom row
+// (where texture coordinate v = 0 is, in assimp's convention).
+struct Image {
+  int width = 0, height = 0;
+  std::vector<double> rgba;  // 0..1
+};
+
+// The material's diffuse or base-colour texture, decoded by VTK's reader for its kind (PNG or
+// JPEG bytes embedded in the file, or a file beside the model); empty when there is none or it
+// cannot be read. `uv` is the texture-coordinate set it names.
+std::optional<Image> texture_of(const aiScene& scene, const aiMaterial* material, const std::filesystem::path& model, unsigned& uv) {
+  aiString name;
+  uv = 0;
+  if (material == nullptr) return std::nullopt;
+  bool found = false;
+  for (const aiTextureType type : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}) {
+    if (!found && material->GetTexture(type, 0, &name, nullptr, &uv) == AI_SUCCESS) found = true;
+  }
+  if (!found) return std::nullopt;
+  vtkSmartPointer<vtkImageReader2> reader;
+  if (const aiTexture* inside = scene.GetEmbeddedTexture(name.C_Str())) {
+    if (inside->mHeight != 0) return std::nullopt;  // raw texels: no test model has them
+    const std::string kind = inside->achFormatHint;
+    if (kind == "png") reader = vtkSmartPointer<vtkPNGReader>::New();
+    else if (kind == "jpg" || kind == "jpeg") reader = vtkSmartPointer<vtkJPEGReader>::New();
+    else return std::nullopt;
+    reader->SetMemoryBuffer(inside->pcData);
+    reader->SetMemoryBufferLength(inside->mWidth);
+  } else {
+    std::string relative = name.C_Str();
+    std::replace(relative.begin(), relative.end(), '\\', '/');
+    const std::string file = (model.parent_path() / relative).string();
+    reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(file.c_str()));
+    if (!reader) return std::nullopt;
+    reader->SetFileName(file.c_str());
+  }
+  reader->Update();
+  vtkImageData* data = reader->GetOutput();
+  Image image;
+  image.width = data->GetDimensions()[0];
+  image.height = data->GetDimensions()[1];
+  const int n = data->GetNumberOfScalarComponents();
+  const double scale = data->GetScalarType() == VTK_UNSIGNED_SHORT ? 65535.0 : 255.0;
+  image.rgba.resize(4 * static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height));
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      double c[4];
+      for (int k = 0; k < 4; ++k) c[k] = k < n ? data->GetScalarComponentAsDouble(x, y, 0, k) / scale : 1.0;
+      double* out = &image.rgba[4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x))];
+      if (n <= 2) {  // grey, with alpha when two
+        out[0] = out[1] = out[2] = c[0];
+        out[3] = n == 2 ? c[1] : 1.0;
+      } else {
+        for (int k = 0; k < 4; ++k) out[k] = k < n ? c[k] : 1.0;
+      }
+    }
+  return image;
+}
+
+// The texture at (u, v): the four texels around the point weighted by their distance to it
+// (texel centres at half-integers), indices wrapping around both ways.
+glm::dvec4 sampled(const Image& image, double u, double v) {
+  const double px = u * image.width - 0.5, py = v * image.height - 0.5;
+  const double x0 = std::floor(px), y0 = std::floor(py);
+  glm::dvec4 sum(0.0);
+  for (const double yy : {y0, y0 + 1.0})
+    for (const double xx : {x0, x0 + 1.0}) {
+      const double weight = (1.0 - std::abs(px - xx)) * (1.0 - std::abs(py - yy));
+      const auto xi = static_cast<std::size_t>(std::fmod(std::fmod(xx, image.width) + image.width, image.width));
+      const auto yi = static_cast<std::size_t>(std::fmod(std::fmod(yy, image.height) + image.height, image.height));
+      const double* texel = &image.rgba[4 * (yi * static_cast<std::size_t>(image.width) + xi)];
+      sum += weight * glm::dvec4(texel[0], texel[1], texel[2], texel[3]);
+    }
+  return sum;
+}
+
+glm::dvec4 material_rgba(const aiMaterial* material, bool textured) {
+  // Without a colour of its own a material is assimp's grey, or white (glTF's factor 1) when
+  // it has a texture.
+  const float grey = textured ? 1.0f : 0.6f;
+  aiColor4D c(grey, grey, grey, 1.0f);
   if (material != nullptr) {
     aiColor4D found;
     if (material->Get(AI_MATKEY_COLOR_DIFFUSE, found) == AI_SUCCESS || material->Get(AI_MATKEY_BASE_COLOR, found) == AI_SUCCESS) {
@@ -43,30 +130,36 @@ glm::dvec4 material_rgba(const aiMaterial* material) {
   return {c.r, c.g, c.b, c.a};
 }
 
-void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, Raw& raw) {
+void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent, const std::filesystem::path& file, Raw& raw) {
   const aiMatrix4x4 to_model = parent * node.mTransformation;
   for (unsigned k = 0; k < node.mNumMeshes; ++k) {
     const aiMesh& mesh = *scene.mMeshes[node.mMeshes[k]];
-    const glm::dvec4 material =
-        material_rgba(mesh.mMaterialIndex < scene.mNumMaterials ? scene.mMaterials[mesh.mMaterialIndex] : nullptr);
-    // A mesh's vertices with the same position and colour are one (docs/scene-file.md: the
-    // model's normals and texture coordinates are not read, so nothing else tells them apart),
-    // which decides where its surface is smooth for the sunlight below.
-    std::map<std::array<float, 7>, std::uint32_t> welded;
+    const aiMaterial* material_of = mesh.mMaterialIndex < scene.mNumMaterials ? scene.mMaterials[mesh.mMaterialIndex] : nullptr;
+    unsigned uv = 0;
+    std::optional<Image> texture = texture_of(scene, material_of, file, uv);
+    if (texture && !mesh.HasTextureCoords(uv)) texture.reset();
+    const glm::dvec4 material = material_rgba(material_of, texture.has_value());
+    // A mesh's vertices with the same position and colour (to the byte) are one
+    // (docs/scene-file.md: the model's normals are not read, and its texture coordinates only
+    // give the colours), which decides where its surface is smooth for the sunlight below.
+    std::map<std::array<double, 7>, std::uint32_t> welded;
     std::vector<std::uint32_t> index(mesh.mNumVertices);
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D& m = mesh.mVertices[v];
-      const aiColor4D c = mesh.HasVertexColors(0) ? mesh.mColors[0][v] : aiColor4D(0, 0, 0, 0);
-      const auto [at, fresh] = welded.try_emplace({m.x, m.y, m.z, c.r, c.g, c.b, c.a}, static_cast<std::uint32_t>(raw.vertices.size()));
+      glm::dvec4 color = material;
+      if (mesh.HasVertexColors(0)) {
+        const aiColor4D c = mesh.mColors[0][v];
+        color = {c.r, c.g, c.b, c.a * material.a};
+      }
+      if (texture) color *= sampled(*texture, mesh.mTextureCoords[uv][v].x, mesh.mTextureCoords[uv][v].y);
+      const std::array<double, 7> key{m.x, m.y, m.z, static_cast<double>(to_byte(color.r)), static_cast<double>(to_byte(color.g)),
+                                      static_cast<double>(to_byte(color.b)), static_cast<double>(to_byte(color.a))};
+      const auto [at, fresh] = welded.try_emplace(key, static_cast<std::uint32_t>(raw.vertices.size()));
       index[v] = at->second;
       if (!fresh) continue;
       const aiVector3D p = to_model * m;
       raw.vertices.emplace_back(p.x, p.y, p.z);
-      if (mesh.HasVertexColors(0)) {
-        raw.colors.emplace_back(c.r, c.g, c.b, c.a * material.a);
-      } else {
-        raw.colors.push_back(material);
-      }
+      raw.colors.push_back(color);
     }
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
@@ -76,7 +169,7 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
       for (const std::uint32_t corner : {a, b, c}) raw.triangles.push_back(corner);
     }
   }
-  for (unsigned k = 0; k < node.mNumChildren; ++k) collect(scene, *node.mChildren[k], to_model, raw);
+  for (unsigned k = 0; k < node.mNumChildren; ++k) collect(scene, *node.mChildren[k], to_model, file, raw);
 }
 
 Raw read_raw(const std::filesystem::path& file) {
@@ -86,7 +179,7 @@ Raw read_raw(const std::filesystem::path& file) {
     throw std::runtime_error(file.string() + ": assimp cannot read it (" + importer.GetErrorString() + ")");
   }
   Raw raw;
-  collect(*scene, *scene->mRootNode, aiMatrix4x4(), raw);
+  collect(*scene, *scene->mRootNode, aiMatrix4x4(), file, raw);
   if (raw.triangles.empty()) throw std::runtime_error(file.string() + ": no triangles");
   return raw;
 }

@@ -64,6 +64,11 @@ ObjectLayer::ObjectLayer(const std::vector<ObjectSpec>& specs, const GroundFunct
       auto m = std::make_unique<Model>();
       const auto t0 = Clock::now();
       m->model = objects::read_model(spec.file);
+      // Not an error: the meshes keep their material's colour, as most viewers draw them.
+      for (const std::string& name : m->model.missing_textures) {
+        std::fprintf(stderr, "terravol: %s: texture '%s' not read; its meshes keep their material's colour\n",
+                     spec.file.string().c_str(), name.c_str());
+      }
       const auto t1 = Clock::now();
       m->lods = objects::make_lods(m->model.mesh, lod);
       m->cube = objects::color_cube(m->model.mesh);

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -124,6 +125,66 @@ TEST(Model, ObjMaterialColourAndOpacity) {
   const Model m = read_model(dir.path() / "m.obj");
   ASSERT_EQ(m.mesh.triangle_count(), 2u);
   for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(255, 0, 0, 128));
+}
+
+// A 2 x 2 texture (a binary PPM beside the model: its first row is the image's top) on a
+// quad whose texture coordinates lie on the texels' centres: each corner takes its texel's
+// colour times the material's (v = 0 is the image's bottom row).
+TEST(Model, TextureColoursAreSampledAtTheVerticesTextureCoordinates) {
+  test::TempDir dir;
+  const std::string ppm = std::string("P6\n2 2\n255\n") + std::string("\x00\x00\xff\xff\xff\xff", 6) +  // top: blue, white
+                          std::string("\xff\x00\x00\x00\xff\x00", 6);                                       // bottom: red, green
+  write(dir.path() / "t.ppm", ppm);
+  write(dir.path() / "m.mtl", "newmtl textured\nKd 1 1 0.5\nmap_Kd t.ppm\n");
+  write(dir.path() / "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "vt 0.25 0.25\nvt 0.75 0.25\nvt 0.75 0.75\nvt 0.25 0.75\nusemtl textured\nf 1/1 2/2 3/3 4/4\n");
+  const Model m = read_model(dir.path() / "m.obj");
+  ASSERT_EQ(m.mesh.triangle_count(), 2u);
+  EXPECT_EQ(m.textured_meshes, 1u);
+  EXPECT_TRUE(m.missing_textures.empty());
+  const std::map<std::pair<double, double>, glm::u8vec4> expected = {
+      {{0.0, 0.0}, {255, 0, 0, 255}}, {{1.0, 0.0}, {0, 255, 0, 255}}, {{1.0, 1.0}, {255, 255, 128, 255}}, {{0.0, 1.0}, {0, 0, 128, 255}}};
+  ASSERT_EQ(m.mesh.vertices.size(), 4u);
+  for (std::size_t v = 0; v < 4; ++v) {
+    const auto it = expected.find({m.mesh.vertices[v].x, m.mesh.vertices[v].y});
+    ASSERT_NE(it, expected.end());
+    EXPECT_EQ(m.mesh.colors[v], it->second) << "vertex " << v;
+  }
+  // Half way between two texels' centres the colour is their mean.
+  write(dir.path() / "h.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0.5 0.25\nvt 0.5 0.25\nvt 0.5 0.25\nusemtl textured\nf 1/1 2/2 3/3\n");
+  for (const auto& c : read_model(dir.path() / "h.obj").mesh.colors) EXPECT_EQ(c, glm::u8vec4(128, 128, 0, 255));
+}
+
+// A texture the material names but that is not there: the material's colour, and its name
+// reported.
+TEST(Model, AMissingTextureLeavesTheMaterialsColourAndIsReported) {
+  test::TempDir dir;
+  write(dir.path() / "m.mtl", "newmtl textured\nKd 0 0 1\nmap_Kd gone.png\n");
+  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
+  const Model m = read_model(dir.path() / "m.obj");
+  EXPECT_EQ(m.textured_meshes, 0u);
+  ASSERT_EQ(m.missing_textures.size(), 1u);
+  EXPECT_EQ(m.missing_textures[0], "gone.png");
+  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 0, 255, 255));
+}
+
+// A texture whose header claims 10^10 pixels is refused from its header, naming the model and
+// the texture.
+TEST(Model, AnAbsurdlyLargeTextureIsRefusedFromItsHeader) {
+  test::TempDir dir;
+  write(dir.path() / "big.ppm", "P6\n100000 100000\n255\n\x01\x02\x03");
+  write(dir.path() / "m.mtl", "newmtl textured\nmap_Kd big.ppm\n");
+  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
+  try {
+    read_model(dir.path() / "m.obj");
+    FAIL() << "an absurd texture was read";
+  } catch (const io::FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("m.obj"), std::string::npos) << what;
+    EXPECT_NE(what.find("big.ppm"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
 }
 
 TEST(Model, BadInputIsOneLineNamingTheFile) {
