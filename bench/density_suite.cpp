@@ -122,8 +122,8 @@ app::render::FrameStats timed_render(app::render::SceneRenderer& scene, const ap
 }
 
 // The cells a refinement with `options` draws from `pose` (the eye at pose.alt above the
-// datum), counted without drawing them: views whose frames would not fit this machine's memory
-// are left out (7.5 million cells took over 24 GB with their faces' vertices).
+// datum), counted without drawing them: views whose frames would take too long or too much
+// memory are left out (kMaxOctreeCells, kMaxEveryCells).
 std::size_t cells_from(app::render::SceneRenderer& scene, const app::scene::CameraPose& pose, const density::RefineOptions& options,
                        const BenchConfig& c) {
   const mrbsp::Camera camera = app::scene::make_scene_camera(scene.frame(), pose, pose.alt, 45.0, c.width, c.height, 1.0);
@@ -149,7 +149,10 @@ json lattice_series(const BenchConfig& c, const Terrain& terrain, const std::fil
   scene.set_auto_slide(false);  // the window stays on the volume, however far the eye
   const app::scene::DensityFigures fig = scene.volumes().density_figures();
   const mrbsp::TraversalOptions traversal;
-  density::RefineOptions octree, every;
+  // The octree as the commands refine it (epsilon and the error tolerance), every voxel cell,
+  // and the papers' criterion alone (projected size; counted, not drawn).
+  const density::RefineOptions octree = app::render::default_density_refinement();
+  density::RefineOptions every, size_only;
   every.leaves_only = true;
   json views = json::array();
   for (const double radii : {1.75, 3.5, 7.0, 14.0}) {
@@ -187,6 +190,7 @@ json lattice_series(const BenchConfig& c, const Terrain& terrain, const std::fil
                  {"octree_ms", median(a)},
                  {"octree_wall_ms", median(wall_a)},
                  {"octree_cells", sa.density.boxes},
+                 {"size_only_cells", cells_from(scene, pose, size_only, c)},
                  {"octree_cells_per_level", sa.density.per_level},
                  {"octree_faces", sa.boxes.faces},
                  {"octree_refine_ms", sa.density_ms},
@@ -292,6 +296,8 @@ json density_suite(const BenchConfig& c, const Terrain& terrain) {
       change.push_back(ms_since(t0));
       after_ms.push_back(density_frame_ms(after));
     }
+    // The transfer function the rest compares with (an odd number of repeats ends on the other).
+    scene.volumes().set_density(0, density::parse_density(kTransfer));
     const app::scene::DensityFigures fig = scene.volumes().density_figures();
     json j = {{"surfaces", surfaces},
               {"frame_ms", to_json(summarize(t))},

@@ -67,29 +67,43 @@ glm::vec4 cover(const glm::vec4& front, const glm::vec4& back) {
 // children beyond the level below, `dc` cells per axis, are clear), 1996 section 4: per axis a,
 // each column of two children composited front over back along a (low face: the low child in
 // front; high face: the high one), and the columns that lie inside the level below averaged.
-Faces compose(const Faces (&child)[8], const std::array<int, 3>& dc, int i, int j, int k, Compositing compositing) {
+// `deviation` gets the largest difference of a channel between a face and one of the
+// columns it averages.
+Faces compose(const Faces (&child)[8], const std::array<int, 3>& dc, int i, int j, int k, Compositing compositing,
+              float& deviation) {
   const auto composite = compositing == Compositing::kOver ? over : cover;
   const int idx[3] = {i, j, k};
   Faces f{};
   for (int a = 0; a < 3; ++a) {
     const int bit = 1 << a, u = (a + 1) % 3, v = (a + 2) % 3;
     glm::vec4 low_first(0.0f), high_first(0.0f);
+    glm::vec4 low_columns[4], high_columns[4];
     int columns = 0;
     for (int c = 0; c < 8; ++c) {
       if (c & bit) continue;
       const int cu = 2 * idx[u] + ((c >> u) & 1), cv = 2 * idx[v] + ((c >> v) & 1);
       if (cu >= dc[static_cast<std::size_t>(u)] || cv >= dc[static_cast<std::size_t>(v)]) continue;
-      ++columns;
       const std::size_t lo = static_cast<std::size_t>(c), hi = static_cast<std::size_t>(c | bit);
-      low_first += composite(child[lo][static_cast<std::size_t>(2 * a)], child[hi][static_cast<std::size_t>(2 * a)]);
-      high_first += composite(child[hi][static_cast<std::size_t>(2 * a + 1)], child[lo][static_cast<std::size_t>(2 * a + 1)]);
+      low_columns[columns] = composite(child[lo][static_cast<std::size_t>(2 * a)], child[hi][static_cast<std::size_t>(2 * a)]);
+      high_columns[columns] = composite(child[hi][static_cast<std::size_t>(2 * a + 1)], child[lo][static_cast<std::size_t>(2 * a + 1)]);
+      low_first += low_columns[columns];
+      high_first += high_columns[columns];
+      ++columns;
     }
     const float w = columns > 0 ? 1.0f / static_cast<float>(columns) : 0.0f;
     f[static_cast<std::size_t>(2 * a)] = w * low_first;
     f[static_cast<std::size_t>(2 * a + 1)] = w * high_first;
+    for (int c = 0; c < columns; ++c) {
+      const glm::vec4 dl = glm::abs(low_columns[c] - f[static_cast<std::size_t>(2 * a)]);
+      const glm::vec4 dh = glm::abs(high_columns[c] - f[static_cast<std::size_t>(2 * a + 1)]);
+      deviation = std::max({deviation, dl.r, dl.g, dl.b, dl.a, dh.r, dh.g, dh.b, dh.a});
+    }
   }
   return f;
 }
+
+// An error in 1/255 units, rounded up and saturated.
+std::uint8_t error_byte(float e) { return static_cast<std::uint8_t>(std::min(255.0f, std::ceil(e * 255.0f - 1e-4f))); }
 
 Packed pack(const Faces& f) {
   Packed p{};
@@ -258,6 +272,7 @@ std::size_t ColorCubeOctree::bytes() const {
   std::size_t b = values_.capacity() * sizeof(float) + base_.capacity() * sizeof(std::int32_t) + weight_.capacity() * sizeof(float) +
                   entries_.capacity() * sizeof(std::int16_t);
   for (const auto& l : packed_) b += l.capacity() * sizeof(Packed);
+  for (const auto& l : errors_) b += l.capacity();
   for (const auto& l : filled_) b += l.capacity() * sizeof(std::array<std::int32_t, 2>);
   return b;
 }
@@ -335,9 +350,27 @@ Faces ColorCubeOctree::build_cell(int level, int i, int j, int k) {
     const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
     child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? build_cell(level - 1, ci, cj, ck) : Faces{};
   }
-  const Faces f = compose(child, dc, i, j, k, options_.compositing);
+  float error = 0.0f;
+  const Faces f = compose(child, dc, i, j, k, options_.compositing, error);
   packed_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)] = pack(f);
+  errors_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)] = error_byte(error + children_error(level, i, j, k));
   return f;
+}
+
+float ColorCubeOctree::children_error(int level, int i, int j, int k) const {
+  if (level <= 1) return 0.0f;
+  const auto& dc = dims_[static_cast<std::size_t>(level - 1)];
+  std::uint8_t most = 0;
+  for (int c = 0; c < 8; ++c) {
+    const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
+    if (ci < dc[0] && cj < dc[1] && ck < dc[2]) most = std::max(most, errors_[static_cast<std::size_t>(level - 1)][cell_index(level - 1, ci, cj, ck)]);
+  }
+  return static_cast<float>(most) / 255.0f;
+}
+
+double ColorCubeOctree::cell_error(int level, int i, int j, int k) const {
+  if (level == 0) return 0.0;
+  return static_cast<double>(errors_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)]) / 255.0;
 }
 
 void ColorCubeOctree::build_all() {
@@ -357,9 +390,12 @@ void ColorCubeOctree::build_all() {
     });
   }
   packed_.assign(dims_.size(), {});
+  errors_.assign(dims_.size(), {});
   for (std::size_t lv = 1; lv < dims_.size(); ++lv) {
     const auto& d = dims_[lv];
-    packed_[lv].assign(static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]), Packed{});
+    const std::size_t cells = static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]);
+    packed_[lv].assign(cells, Packed{});
+    errors_[lv].assign(cells, 0);
   }
   const int top = levels() - 1;
   // The level whose subtrees are built in parallel: the highest with at least 64 cells.
@@ -396,9 +432,11 @@ void ColorCubeOctree::build_all() {
             child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? above[static_cast<std::size_t>(lv - 1)][cell_index(lv - 1, ci, cj, ck)]
                                                               : Faces{};
           }
-          const Faces f = compose(child, dc, i, j, k, options_.compositing);
+          float error = 0.0f;
+          const Faces f = compose(child, dc, i, j, k, options_.compositing, error);
           out[cell_index(lv, i, j, k)] = f;
           packed_[static_cast<std::size_t>(lv)][cell_index(lv, i, j, k)] = pack(f);
+          errors_[static_cast<std::size_t>(lv)][cell_index(lv, i, j, k)] = error_byte(error + children_error(lv, i, j, k));
         }
   }
   build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -505,7 +543,9 @@ void ColorCubeOctree::refine(const mrbsp::Camera& camera, const RefineOptions& o
       const double dist = std::max(glm::length(nearest - eye), camera.near_plane);
       const glm::dvec3 side = hi - lo;
       const double size_px = std::max({side.x, side.y, side.z}) * focal_px / dist;
-      if (size_px < options.threshold_px) {
+      const bool within = options.error_tolerance > 0.0 && size_px < options.max_size_px &&
+                          errors_[static_cast<std::size_t>(it.level)][cell_index(it.level, it.i, it.j, it.k)] <= options.error_tolerance * 255.0 + 1e-9;
+      if (size_px < options.threshold_px || within) {
         emit(it.level, it.i, it.j, it.k, lo, hi, unpack(packed));
         continue;
       }

@@ -60,6 +60,13 @@ struct RefineOptions {
                               // fewer pixels; else its children are visited
   bool leaves_only = false;   // open every cell down to the leaves (drawing every voxel cell)
   bool cull = true;           // leave out cells outside the view frustum
+  // With a tolerance above 0, a cell whose faces stand for its whole subtree within it (its
+  // error, ColorCubeOctree::cell_error) is also drawn as its faces while it spans fewer than
+  // max_size_px pixels: the error-bounded level of hierarchical splatting (Laur and Hanrahan
+  // 1991), which Chamberlain et al. 1996 (section 2) cite as their volume counterpart. 0 (the
+  // default): the projected size alone decides, as in the papers.
+  double error_tolerance = 0.0;  // premultiplied RGBA, 0..1 per channel
+  double max_size_px = 8.0;
 };
 
 struct RefineStats {
@@ -112,6 +119,11 @@ class ColorCubeOctree {
   float corner_value(int i, int j, int k) const;
   void cell_box(int level, int i, int j, int k, glm::dvec3& lo, glm::dvec3& hi) const;
   std::array<glm::vec4, 6> cell_faces(int level, int i, int j, int k) const;
+  // A cell's error, premultiplied RGBA (0..1, to 1/255 above): how far its faces may be from
+  // what its subtree shows there. Per face, the largest difference of a channel between the
+  // face and one of the columns of children it averages, plus the largest error of its
+  // children (0 for a leaf).
+  double cell_error(int level, int i, int j, int k) const;
 
   using Faces = std::array<glm::vec4, 6>;  // premultiplied, float
   // What a cell above the leaves keeps per face: straight sRGB and sqrt(alpha), 8 bits each
@@ -121,6 +133,7 @@ class ColorCubeOctree {
  private:
   Faces leaf_faces(int i, int j, int k) const;
   Faces build_cell(int level, int i, int j, int k);
+  float children_error(int level, int i, int j, int k) const;  // the largest of its children's
   bool maybe_filled(int level, int i, int j, int k) const;
   std::size_t cell_index(int level, int i, int j, int k) const;
   void build_all();
@@ -143,6 +156,8 @@ class ColorCubeOctree {
   // each transfer function (each corner is shared by eight leaves).
   std::vector<std::int16_t> entries_;
   std::vector<std::vector<Packed>> packed_;  // per level >= 1
+  // Per level >= 1, per cell: its error in 1/255 units, rounded up (255: 255 or more).
+  std::vector<std::vector<std::uint8_t>> errors_;
   double build_ms_ = 0.0, resample_ms_ = 0.0;
 };
 

@@ -56,7 +56,7 @@ struct FlyOptions {
   bool resume = false, force = false;
   std::vector<std::string> objects;  // --object, added to the scene's
   std::string density;               // --density: replaces every volume's density style
-  std::optional<double> density_threshold;
+  std::optional<double> density_threshold, density_error;
 };
 
 bool is_video(const std::filesystem::path& p) {
@@ -128,6 +128,7 @@ void run_fly(const FlyOptions& o) {
   }
   given.threshold = o.threshold;
   given.density_threshold = o.density_threshold;
+  given.density_error = o.density_error;
   const scene::SceneStyle style = scene::overlay(scene.style, given);
   const scene::Style st = scene::resolve_style(style);
   const int width = st.width, height = st.height;
@@ -171,6 +172,7 @@ void run_fly(const FlyOptions& o) {
   if (!o.objects.empty()) manifest["objects"] = o.objects;
   if (!o.density.empty()) manifest["density"] = o.density;
   if (o.density_threshold) manifest["density_threshold"] = *o.density_threshold;
+  if (o.density_error) manifest["density_error"] = *o.density_error;
   if (tiled) {  // frames of another renderer or sampling are other frames (absent: VTK, as before)
     manifest["renderer"] = scene::engine_name(o.drawn.engine);
     manifest["aa"] = o.drawn.aa;
@@ -367,7 +369,7 @@ void add_fly_command(CLI::App& app) {
                                         "(VTK needs an X display, --renderer tiler does not; docs/camera-paths.md)");
   auto o = std::make_shared<FlyOptions>();
   struct Raw {
-    double threshold = 0, start = 0, end = 0, density_threshold = 0;
+    double threshold = 0, start = 0, end = 0, density_threshold = 0, density_error = 0;
     RendererArgs renderer;
   };
   auto raw = std::make_shared<Raw>();
@@ -379,6 +381,7 @@ void add_fly_command(CLI::App& app) {
                                     "LOD threshold in pixels for keys without their own (default: the scene's, else 2)");
   add_density_option(*cmd, o->density);
   auto* density_threshold = add_density_threshold_option(*cmd, raw->density_threshold);
+  auto* density_error = add_density_error_option(*cmd, raw->density_error);
   cmd->add_option("--crf", o->crf, "H.264 quality, 0 (lossless) .. 51 (worst)")->capture_default_str();
   auto* png_level = cmd->add_option("--png-level", o->png_level,
                                     "PNG frames' zlib compression, 0 (none) .. 9 (smallest, slowest)")
@@ -394,7 +397,7 @@ void add_fly_command(CLI::App& app) {
                   "the size and box-filtered down)")
       ->capture_default_str();
   add_renderer_options(*cmd, raw->renderer);
-  cmd->callback([o, raw, threshold, start, end, density_threshold, png_level] {
+  cmd->callback([o, raw, threshold, start, end, density_threshold, density_error, png_level] {
     if (!(o->fps > 0.0 && o->fps <= 240.0)) throw std::invalid_argument("--fps " + fixed(o->fps, 3) + ": must be within (0, 240]");
     if (o->crf < 0 || o->crf > 51) throw std::invalid_argument("--crf " + std::to_string(o->crf) + ": must be within 0..51");
     if (o->png_level < 0 || o->png_level > 9) {
@@ -419,6 +422,7 @@ void add_fly_command(CLI::App& app) {
       o->threshold = raw->threshold;
     }
     if (density_threshold->count() > 0) o->density_threshold = raw->density_threshold;
+    if (density_error->count() > 0) o->density_error = raw->density_error;
     if (!o->density.empty()) density::parse_density(o->density);  // bad text fails before any work
     if (start->count() > 0) o->start = raw->start;
     if (end->count() > 0) o->end = raw->end;

@@ -70,6 +70,8 @@ void add_scene_options(CLI::App& cmd, SceneArgs& args) {
                               "the image is the same either way");
   s.density_threshold = defaults.density_threshold;
   s.density_threshold_option = add_density_threshold_option(cmd, s.density_threshold)->capture_default_str();
+  s.density_error = defaults.density_error;
+  s.density_error_option = add_density_error_option(cmd, s.density_error)->capture_default_str();
   s.coherence_option = option("--coherence", s.coherence,
                               "Occlusion tests reused from frame to frame (Bittner and Havran): off, update or "
                               "conservative; with --occlusion on");
@@ -92,6 +94,13 @@ CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold) {
   return cmd.add_option("--density-threshold", threshold,
                         "Density: a colour cube is drawn as its faces once its largest side spans fewer pixels than "
                         "this (epsilon; in view, keys E and Shift+E)");
+}
+
+CLI::Option* add_density_error_option(CLI::App& cmd, double& levels) {
+  return cmd.add_option("--density-error", levels,
+                        "Density: a colour cube whose faces stand for its contents within this many 1/255 levels "
+                        "(premultiplied colour and opacity) is also drawn whole while it spans fewer than 8 pixels; "
+                        "0: off, the projected size alone decides");
 }
 
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts) {
@@ -161,6 +170,7 @@ scene::SceneStyle given_style(const SceneArgs& args) {
   if (given(s.occlusion_option)) g.occlusion = s.occlusion;
   if (given(s.coherence_option)) g.coherence = s.coherence;
   if (given(s.density_threshold_option)) g.density_threshold = s.density_threshold;
+  if (given(s.density_error_option)) g.density_error = s.density_error;
   if (args.no_legend) g.legend = false;
   if (args.no_markers) g.markers = false;
   return g;

@@ -17,17 +17,18 @@
 namespace terravol::app::cli {
 
 // The style options as given: --size, --lod-metric, --threshold, --order, --tint, --window,
-// --haze, --sun-azimuth, --sun-elevation, --surface-triangles, --occlusion, --coherence, --density-threshold. The values start at
+// --haze, --sun-azimuth, --sun-elevation, --surface-triangles, --occlusion, --coherence, --density-threshold,
+// --density-error. The values start at
 // scene::Style's defaults (shown in --help); only the options given count (given_style).
 struct StyleArgs {
   std::string size, metric, order, tint, occlusion, coherence;
-  double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0, density_threshold = 0.0;
+  double threshold = 0.0, haze_km = 0.0, sun_azimuth = 0.0, sun_elevation = 0.0, density_threshold = 0.0, density_error = 0.0;
   int window = 0;
   std::size_t surface_triangles = 0;
   CLI::Option *size_option = nullptr, *metric_option = nullptr, *threshold_option = nullptr,
               *order_option = nullptr, *tint_option = nullptr, *window_option = nullptr, *haze_option = nullptr,
               *sun_azimuth_option = nullptr, *sun_elevation_option = nullptr, *surface_option = nullptr,
-              *occlusion_option = nullptr, *coherence_option = nullptr, *density_threshold_option = nullptr;
+              *occlusion_option = nullptr, *coherence_option = nullptr, *density_threshold_option = nullptr, *density_error_option = nullptr;
 };
 
 // The scene options: --scene, --volume, --field, --volume-frame, --iso, --slice, --density,
@@ -49,6 +50,8 @@ CLI::Option* add_object_option(CLI::App& cmd, std::vector<std::string>& objects)
 CLI::Option* add_density_option(CLI::App& cmd, std::string& density);
 // --density-threshold PIXELS (epsilon of the colour cubes).
 CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold);
+// --density-error LEVELS (the colour cubes' error tolerance, 1/255 levels).
+CLI::Option* add_density_error_option(CLI::App& cmd, double& levels);
 // The scene objects of --object texts (scene::parse_object; the files are read later).
 std::vector<scene::ObjectSpec> parse_objects(const std::vector<std::string>& texts);
 

@@ -55,6 +55,7 @@ SceneOptions scene_options(const scene::Style& style, int levels, Sliding slidin
   o.surface_triangles = style.surface_triangles;
   o.sliding = sliding;
   o.density.threshold_px = style.density_threshold;
+  o.density.error_tolerance = style.density_error / 255.0;
   return o;
 }
 

@@ -56,6 +56,15 @@ enum class Sliding : std::uint8_t {
   kAsynchronous,  // read and shade on a worker thread; the first frame after that slides the tree
 };
 
+// The density refinement of a style left at its defaults (scene::kDefaultDensityThreshold and
+// scene::kDefaultDensityError).
+inline density::RefineOptions default_density_refinement() {
+  density::RefineOptions o;
+  o.threshold_px = scene::kDefaultDensityThreshold;
+  o.error_tolerance = scene::kDefaultDensityError / 255.0;
+  return o;
+}
+
 struct SceneOptions {
   int max_window = 1024;  // cells, a power of two >= 2
   int levels = 0;         // 0: scene::default_levels(window)
@@ -71,7 +80,8 @@ struct SceneOptions {
   // without wireframe or LOD colours.
   scene::Engine engine = scene::Engine::kVtk;
   tiler::Settings tiler;  // kTiler: aa, texel rate, bands, threads (the size is the RenderSettings')
-  density::RefineOptions density;  // how the density is refined (threshold: epsilon, pixels)
+  // How the density is refined (threshold: epsilon, pixels; the error tolerance Style's default).
+  density::RefineOptions density = default_density_refinement();
   // The camera's near plane, metres; 0: scene::near_plane_for(the eye's clearance). The tree's
   // order draws without a depth buffer, so only clipping depends on it; the depth-tested
   // orders' precision does (24 bits over [near, far]).

@@ -191,7 +191,7 @@ SceneCamera camera_of(const Reader& r, const json& j) {
 SceneStyle style_of(const Reader& r, const json& j) {
   r.only_keys(j, "render", {"size", "threshold", "lod_metric", "order", "tint", "window", "haze_km", "sun_azimuth",
                             "sun_elevation", "legend", "markers", "surface_triangles", "occlusion", "coherence",
-                            "density_threshold"});
+                            "density_threshold", "density_error"});
   SceneStyle s;
   auto text = [&](const char* key, auto check) -> std::optional<std::string> {
     if (!j.contains(key)) return std::nullopt;
@@ -217,6 +217,7 @@ SceneStyle style_of(const Reader& r, const json& j) {
   if (j.contains("density_threshold")) {
     s.density_threshold = r.number(j["density_threshold"], "render.density_threshold", kMinDensityThreshold, kMaxDensityThreshold);
   }
+  if (j.contains("density_error")) s.density_error = r.number(j["density_error"], "render.density_error", 0.0, kMaxDensityError);
   s.lod_metric = text("lod_metric", [](const std::string& v) { parse_metric(v); });
   s.order = text("order", [](const std::string& v) { parse_order(v); });
   s.tint = text("tint", [](const std::string& v) { parse_tint(v); });

@@ -33,7 +33,7 @@ constexpr auto kStyleKeys =
                     &SceneStyle::order, &SceneStyle::tint, &SceneStyle::window, &SceneStyle::haze_km,
                     &SceneStyle::sun_azimuth, &SceneStyle::sun_elevation, &SceneStyle::legend, &SceneStyle::markers,
                     &SceneStyle::surface_triangles, &SceneStyle::occlusion, &SceneStyle::coherence,
-                    &SceneStyle::density_threshold);
+                    &SceneStyle::density_threshold, &SceneStyle::density_error);
 
 }  // namespace
 
@@ -70,6 +70,15 @@ Style resolve_style(const SceneStyle& s) {
       throw std::invalid_argument(b);
     }
     r.density_threshold = t;
+  }
+  if (s.density_error) {
+    const double e = *s.density_error;
+    if (!(e >= 0.0 && e <= kMaxDensityError)) {
+      char b[128];
+      std::snprintf(b, sizeof b, "--density-error %g: expected levels within [0, %g]", e, kMaxDensityError);
+      throw std::invalid_argument(b);
+    }
+    r.density_error = e;
   }
   return r;
 }

@@ -42,6 +42,11 @@ inline constexpr std::size_t kDefaultSurfaceTriangles = 12000;
 // pixel"); the range the options, the scene file and the viewer's keys accept.
 inline constexpr double kDefaultDensityThreshold = 1.0;
 inline constexpr double kMinDensityThreshold = 0.25, kMaxDensityThreshold = 64.0;
+// Densities: a colour cube whose faces stand for its contents within this many 1/255 levels
+// (premultiplied; density::RefineOptions::error_tolerance) is also drawn whole while it spans
+// fewer than 8 pixels; 0 turns that off (Chamberlain's projected size alone).
+inline constexpr double kDefaultDensityError = 1.0;
+inline constexpr double kMaxDensityError = 64.0;
 
 // The "render" object of a scene file (docs/scene-file.md), or what a command line gave: every
 // key optional; what is absent is decided by the next source (overlay) or the default
@@ -55,7 +60,7 @@ struct SceneStyle {
   std::optional<bool> legend, markers;
   std::optional<std::size_t> surface_triangles;
   std::optional<std::string> occlusion, coherence;
-  std::optional<double> density_threshold;
+  std::optional<double> density_threshold, density_error;
 };
 
 // A style with every key decided.
@@ -70,6 +75,7 @@ struct Style {
   bool markers = true;              // a marker at each transmitter a volume records
   std::size_t surface_triangles = kDefaultSurfaceTriangles;  // per isosurface; 0: all
   double density_threshold = kDefaultDensityThreshold;        // pixels (epsilon)
+  double density_error = kDefaultDensityError;                // 1/255 levels, premultiplied; 0: off
   // traversal.occlusion and traversal.coherence come from "occlusion" (on | off, default off)
   // and "coherence" (off | update | conservative, default off).
 };

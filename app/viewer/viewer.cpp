@@ -1151,6 +1151,7 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
     j["volumes"].push_back(jv);
   }
   j["density_threshold"] = pipeline_->density_options().threshold_px;
+  j["density_error"] = pipeline_->density_options().error_tolerance * 255.0;
   const scene::MergeFigures& merge = pipeline_->merge_figures();
   j["merged_triangles"] = merge.tree_triangles;
   j["merge"] = {{"input_triangles", merge.input_triangles},

@@ -246,6 +246,68 @@ TEST(Octree, RefinementDrawsCellsBelowEpsilonAndEveryLeafWhenAsked) {
   EXPECT_EQ(stats.per_level[0], filled);
 }
 
+// A cell's error: 0 where its children are alike, above 0 where a step in the field runs
+// through it, and never less than a child's (it stands for its whole subtree). With a
+// tolerance, refinement draws fewer cells, none wider than max_size_px, and every cell it
+// draws whole above epsilon is within the tolerance.
+TEST(Octree, ACellsErrorMeasuresHowUnlikeItsChildrenAreAndBoundsItsSubtree) {
+  const io::SceneFrame frame(45.0, 6.0);
+  // 16 x 16 x 8 leaves; the value steps from 120 to 90 dB between lattice columns 8 and 9.
+  const volume::Volume v =
+      geographic_volume(17, 17, 9, 6.0, 45.0, 0.002, 0.002, 0.0, 60.0, false, [](int i, int, int) { return i <= 8 ? 120.0f : 90.0f; });
+  const ColorCubeOctree o(v, frame, {}, parse_density("range=80:150,colormap=viridis,opacity=3"));
+  ASSERT_GE(o.levels(), 3);
+  // Cells above the lowest (where the frame's curvature leaves some box corners below the
+  // lattice's first layer, clear).
+  for (int k = 1; k < 3; ++k)
+    for (int j = 0; j < 8; ++j) {
+      for (int i = 0; i < 4; ++i) EXPECT_EQ(o.cell_error(1, i, j, k), 0.0) << "uniform cell " << i << " " << j << " " << k;
+      EXPECT_GT(o.cell_error(1, 4, j, k), 0.0) << "the step runs through leaf 8, in cell 4";
+    }
+  for (int level = 2; level < o.levels(); ++level) {
+    const auto d = o.cells_at(level), dc = o.cells_at(level - 1);
+    for (int k = 0; k < d[2]; ++k)
+      for (int j = 0; j < d[1]; ++j)
+        for (int i = 0; i < d[0]; ++i)
+          for (int c = 0; c < 8; ++c) {
+            const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
+            if (ci >= dc[0] || cj >= dc[1] || ck >= dc[2]) continue;
+            EXPECT_GE(o.cell_error(level, i, j, k), o.cell_error(level - 1, ci, cj, ck));
+          }
+  }
+  // Refinement: a seeded path-loss field from a near camera.
+  const volume::Volume field = test::path_loss_volume(33, 25, 11, false);
+  const ColorCubeOctree p(field, frame, {}, parse_density("range=80:150,colormap=viridis,opacity=1"));
+  const BoxGrid& g = p.grid();
+  const glm::dvec3 centre = g.origin + 0.5 * g.size * glm::dvec3(g.boxes[0], g.boxes[1], g.boxes[2]);
+  mrbsp::Camera c;
+  c.eye = centre + glm::dvec3(-3600.0, -4800.0, 2400.0);
+  c.forward = glm::normalize(centre - c.eye);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  c.width = 640;
+  c.height = 360;
+  const double focal = c.height * 0.5 / std::tan(glm::radians(c.fov_y_deg) * 0.5);
+  std::size_t last = std::numeric_limits<std::size_t>::max();
+  for (const double tolerance : {0.0, 2.0 / 255.0, 8.0 / 255.0, 32.0 / 255.0}) {
+    RefineOptions options;
+    options.error_tolerance = tolerance;
+    std::vector<mrbsp::ColorBox> boxes;
+    RefineStats stats;
+    p.refine(c, options, boxes, stats);
+    EXPECT_LE(boxes.size(), last) << "tolerance " << tolerance * 255.0;
+    last = boxes.size();
+    for (const mrbsp::ColorBox& b : boxes) {
+      const glm::dvec3 lo(b.lo), hi(b.hi);
+      const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) * focal / glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
+      const bool leaf = hi.x - lo.x <= g.size.x * 1.001 && hi.y - lo.y <= g.size.y * 1.001 && hi.z - lo.z <= g.size.z * 1.001;
+      if (!leaf) {
+        EXPECT_LT(size, tolerance > 0.0 ? options.max_size_px : options.threshold_px);
+      }
+    }
+  }
+  EXPECT_LT(last, 100000u);
+}
+
 // Chamberlain's O(log n): far away, a lattice refined twice per axis draws about as many cells
 // (the extra level is never opened).
 TEST(Octree, AFarViewDrawsAboutAsManyCellsWhenTheLatticeIsRefined) {

@@ -70,6 +70,16 @@ TEST(DensityReference, ColourCubesAgreeWithTheRayMarcherFromNearAndFar) {
     if (epsilon == 1.0) {  // the targets at the default epsilon: mean <= 2/255, 99th percentile <= 16/255
       EXPECT_LE(e[0].mean, 2.0) << d << " radii";
       EXPECT_LE(e[0].p99, 16.0) << d << " radii";
+      // With the commands' error tolerance (1/255; cells up to 8 px): the same targets.
+      RefineOptions tolerant{epsilon, false, true};
+      tolerant.error_tolerance = 1.0 / 255.0;
+      std::vector<mrbsp::ColorBox> boxes;
+      RefineStats stats;
+      over.refine(c, tolerant, boxes, stats);
+      const reference::FootprintError t = compare(test::composite_boxes(boxes, c.eye, c.forward, c.up, c.fov_y_deg, c.width, c.height), marched);
+      EXPECT_LE(t.mean, 2.0) << d << " radii, tolerance 1";
+      EXPECT_LE(t.p99, 16.0) << d << " radii, tolerance 1";
+      std::printf("%.2f radii, tolerance 1/255: %zu boxes, mean %.2f p99 %.1f\n", d, boxes.size(), t.mean, t.p99);
     } else {  // coarse cells drawn: the default (1996's over) is the closer one
       EXPECT_LE(e[0].mean, e[1].mean) << d << " radii";
       EXPECT_LE(e[0].mean, 4.5) << d << " radii";

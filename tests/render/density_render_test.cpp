@@ -173,6 +173,8 @@ TEST(DensityOptions, BadDensityTextAndThresholdsFailWithOneLine) {
       {" --density range=80:150,colormap=viridis", "no opacity"},
       {" --density range=80:150,colormap=viridis,opacity=1 --density-threshold 0", "--density-threshold 0"},
       {" --density range=80:150,colormap=viridis,opacity=1 --density-threshold nan", "--density-threshold"},
+      {" --density range=80:150,colormap=viridis,opacity=1 --density-error -1", "--density-error -1"},
+      {" --density range=80:150,colormap=viridis,opacity=1 --density-error 1000", "--density-error 1000"},
   };
   for (const auto& [extra, expected] : cases) {
     const auto r = run_terravol(base + extra);
@@ -180,6 +182,16 @@ TEST(DensityOptions, BadDensityTextAndThresholdsFailWithOneLine) {
     EXPECT_NE(r.err.find(expected), std::string::npos) << extra << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+TEST(DensityOptions, ADensityErrorOutOfRangeInASceneFileNamesItsKey) {
+  test::TempDir dir;
+  const auto scene = dir.path() / "s.json";
+  std::ofstream(scene) << R"({"dem": [")" << bundled_dem() << R"("], "render": {"density_error": 100}})";
+  const auto r = run_terravol("render --scene " + scene.string() + " --camera 45.4,6.4,3000,40,-20 -o /tmp/never.png");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("render.density_error"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
 TEST(DensityOptions, ABadDensityInASceneFileNamesItsKey) {
