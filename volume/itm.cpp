@@ -204,13 +204,12 @@ void fit_window(double x1, double x2, double xi, int n, int& ja, int& jb) {
   jb = static_cast<int>(b);
 }
 
-// The k-th smallest (0-based; kLargest: the k-th largest) of c[0..count), count > k,
-// reordering c. With few values beyond it, by taking the extreme off count - 1 - k times
-// (branch-free passes over a few dozen values); else std::nth_element.
+// The k-th smallest (0-based; kLargest: the k-th largest) of c[0..count), count > k, reordering
+// c (room for count rounded up to kSumParts). With few values beyond it, by taking the extreme
+// off count - 1 - k times (the kernel's, four values at a time); else std::nth_element.
 template <bool kLargest>
 double kth_extreme(double* c, std::size_t count, std::size_t k) {
-  std::size_t beyond = count - 1 - k;
-  if (beyond > 8) {
+  if (count - 1 - k > 8) {
     if constexpr (kLargest) {
       std::nth_element(c, c + k, c + count, std::greater<double>());
     } else {
@@ -218,21 +217,7 @@ double kth_extreme(double* c, std::size_t count, std::size_t k) {
     }
     return c[k];
   }
-  auto extreme = [](double a, double b) { return kLargest ? std::min(a, b) : std::max(a, b); };
-  for (;;) {
-    // Two running extremes (exact in any order), then the first place of it.
-    double top = c[0], top2 = c[count - 1];
-    for (std::size_t i = 1; i + 1 < count; i += 2) {
-      top = extreme(top, c[i]);
-      top2 = extreme(top2, c[i + 1]);
-    }
-    top = extreme(top, top2);
-    if (beyond == 0) return top;
-    std::size_t at = 0;
-    while (c[at] != top) ++at;
-    c[at] = c[--count];
-    --beyond;
-  }
+  return use_avx2() ? itm_kernel::avx2::kth_extreme(c, count, k, kLargest) : kernel::kth_extreme(c, count, k, kLargest);
 }
 
 double delta_h_of(const double* z, int np, double xi, double x1, double x2, DeltaHScratch& w) {
@@ -265,8 +250,9 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   // 16 and 64 times wider, then all. Exact whatever the guess: it only decides how much is
   // gathered. Deviation i is s[i] - (at0 + slope i), computed alike wherever it is needed.
   const auto rank = static_cast<std::size_t>(ka - 1);
-  const bool guessed = std::isfinite(w.lower) && std::isfinite(w.upper) && w.upper > w.lower;
-  const double range = guessed ? w.upper - w.lower : 0.0;
+  DeltaHGuess& g = w.guess;
+  const bool guessed = std::isfinite(g.lower) && std::isfinite(g.upper) && g.upper > g.lower;
+  const double range = guessed ? g.upper - g.lower : 0.0;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double* low = w.low.data();
   double* high = w.high.data();
@@ -279,7 +265,7 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   };
   std::size_t n_low = 0, n_high = 0;
   if (guessed) {
-    const itm_kernel::Counts c = beyond(true, w.lower + w.low_margin * range, true, w.upper - w.high_margin * range);
+    const itm_kernel::Counts c = beyond(true, g.lower + g.low_margin * range, true, g.upper - g.high_margin * range);
     n_low = c.low;
     n_high = c.high;
     auto adapt = [&](double& margin, std::size_t count) {
@@ -289,12 +275,12 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
         margin = std::max(0.75 * margin, 0.002);
       }
     };
-    adapt(w.low_margin, n_low);
-    adapt(w.high_margin, n_high);
+    adapt(g.low_margin, n_low);
+    adapt(g.high_margin, n_high);
     for (double widen = 4.0; widen <= 64.0 && (n_low <= rank || n_high <= rank); widen *= 4.0) {
       const bool redo_low = n_low <= rank, redo_high = n_high <= rank;
       const itm_kernel::Counts again =
-          beyond(redo_low, w.lower + widen * w.low_margin * range, redo_high, w.upper - widen * w.high_margin * range);
+          beyond(redo_low, g.lower + widen * g.low_margin * range, redo_high, g.upper - widen * g.high_margin * range);
       if (redo_low) n_low = again.low;
       if (redo_high) n_high = again.high;
     }
@@ -307,8 +293,8 @@ double delta_h_of(const double* z, int np, double xi, double x1, double x2, Delt
   }
   const double lower = kth_extreme<false>(low, n_low, rank);
   const double upper = kth_extreme<true>(high, n_high, rank);
-  w.lower = lower;
-  w.upper = upper;
+  g.lower = lower;
+  g.upper = upper;
   return (upper - lower) / (1.0 - 0.8 * std::exp(-(x2 - x1) / 50e3));
 }
 
@@ -394,6 +380,10 @@ ItmPath::ItmPath(double frequency_mhz, const ItmParameters& parameters)
   g_minus_ = climate.g_minus(ln_k);
   g_plus_ = climate.g_plus(ln_k);
   dexa_frequency_m_ = std::cbrt(575.7e12 / wn_);
+  // Terms of the frequency and the ground alone, for every path.
+  free_space_frequency_db_ = 32.45 + 20.0 * std::log10(frequency_mhz);
+  ln_inverse_abs_zg_ = std::log(inverse_abs_zg_);
+  ln_scatter_wn_ = std::log(47.7 * wn_);
   z_time_ = itm_functions::inverse_normal(parameters.time);
   z_location_ = itm_functions::inverse_normal(parameters.location);
   z_situation_ = itm_functions::inverse_normal(parameters.situation);
@@ -426,7 +416,7 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
   const double zs = (sum_z_[static_cast<std::size_t>(n_ - p10 + 1)] - sum_z_[static_cast<std::size_t>(p10)]) /
                     (n_ - 2 * p10 + 1);
   ns_ = p_.refractivity * std::exp(-zs / 9460.0);
-  free_space_path_db_ = 32.45 + 20.0 * std::log10(frequency_mhz_) + 20.0 * std::log10(dist_ / 1000.0);
+  free_space_path_db_ = free_space_frequency_db_ + 20.0 * std::log10(dist_ / 1000.0);
   gme_ = kGammaA * (1.0 - 0.04665 * std::exp(ns_ / 179.3));
 
   // Horizon terms: elevation angles on the Earth of curvature gamma_e (heights relative to the
@@ -461,6 +451,8 @@ void ItmPath::set_profile(std::span<const double> ground_m, double spacing_m, do
     }
   }
   dh_x1_ = dh_x2_ = -1.0;
+  if (std::isfinite(dh_first_guess_.lower)) dh_scratch_.guess = dh_first_guess_;
+  dh_first_ = true;
   rx_hull_built_ = false;
   xae_ = std::cbrt(1.0 / (wn_ * gme_ * gme_));
 }
@@ -506,6 +498,8 @@ double ItmPath::delta_h(double x1, double x2) {
     dh_x1_ = x1;
     dh_x2_ = x2;
     dh_value_ = delta_h_of(z_.data(), n_, xi_, x1, x2, dh_scratch_);
+    if (dh_first_) dh_first_guess_ = dh_scratch_.guess;
+    dh_first_ = false;
   }
   return dh_value_;
 }
@@ -569,14 +563,14 @@ void ItmPath::kernel_path(itm_kernel::Path& k) const {
   k.zg_re = zg_re_;
   k.zg_im = zg_im_;
   k.inverse_abs_zg = inverse_abs_zg_;
-  k.ln_inverse_abs_zg = std::log(inverse_abs_zg_);
+  k.ln_inverse_abs_zg = ln_inverse_abs_zg_;
   k.dist = dist_;
   k.ln_dist = std::log(dist_);
   k.hg_tx = hg_tx_;
   k.free_space_db = free_space_path_db_;
   k.decay_d4 = std::exp(-2.7574 * xae_ / 50e3);
   k.decay_dist = std::exp(-dist_ / 50e3);
-  k.scatter_offset = 0.3 * xae_ * std::log(47.7 * wn_);
+  k.scatter_offset = 0.3 * xae_ * ln_scatter_wn_;
   // The warnings of the frequency, the medium, the transmitter and the path length (the
   // Algorithm's range checks less the receiver's).
   double w = 0.0;

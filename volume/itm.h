@@ -84,12 +84,15 @@ struct ItmLoss {
 };
 
 // Scratch space of the terrain irregularity: the resampled profile, the candidates for its
-// quantiles, and the last quantiles found with the margins to search within (a guess for the
-// next, which only decides how fast they are found).
-struct DeltaHScratch {
-  std::vector<double> samples, low, high, spare;
+// quantiles, and the guess: the last quantiles found with the margins to search within (for
+// the next, which only decides how fast they are found).
+struct DeltaHGuess {
   double lower = std::nan(""), upper = std::nan("");
   double low_margin = 0.02, high_margin = 0.02;  // fractions of upper - lower
+};
+struct DeltaHScratch {
+  std::vector<double> samples, low, high, spare;
+  DeltaHGuess guess;
 };
 
 namespace itm_kernel {
@@ -146,9 +149,11 @@ class ItmPath {
 
   double wn_ = 0.0;                   // wave number, 1/m (the Algorithm's k = f / 47.7 MHz m)
   double zg_re_ = 0.0, zg_im_ = 0.0;  // surface transfer impedance of the ground
-  double inverse_abs_zg_ = 0.0;
+  double inverse_abs_zg_ = 0.0, ln_inverse_abs_zg_ = 0.0;
   double g_minus_ = 0.0, g_plus_ = 0.0, dexa_frequency_m_ = 0.0;  // the statistics' frequency terms
   double frequency_mhz_ = 0.0;
+  double free_space_frequency_db_ = 0.0;  // 32.45 + 20 log10(f / MHz)
+  double ln_scatter_wn_ = 0.0;            // ln(47.7 k), of troposcatter's least distance
   ItmParameters p_;
   double z_time_ = 0.0, z_location_ = 0.0, z_situation_ = 0.0;  // standard normal deviates
 
@@ -174,6 +179,10 @@ class ItmPath {
   // Delta h depends on the window (x1, x2) only: the last one is kept.
   double dh_x1_ = -1.0, dh_x2_ = -1.0, dh_value_ = 0.0;
   DeltaHScratch dh_scratch_;
+  // The guess after a profile's first Delta h, the guess for the next profile's first: a
+  // column's lowest receiver is more like its neighbour's lowest than its highest.
+  DeltaHGuess dh_first_guess_;
+  bool dh_first_ = true;
 };
 
 // One path, one receiver height: ItmPath(frequency, parameters), set_profile(), loss().

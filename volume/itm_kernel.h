@@ -57,6 +57,11 @@ struct Lanes {
   double loss_db[kLanes] = {}, attenuation_db[kLanes] = {}, reference_db[kLanes] = {};
   double mode[kLanes] = {};  // 0 line of sight, 1 diffraction, 2 troposcatter
   double warning[kLanes] = {};
+  // The transmitter's terms of the last evaluation (its horizon distance and effective height
+  // in, its rounded-Earth distance, height gain and d_e term out): a trans-horizon column's are
+  // the same at every height, so they are reused while their inputs are equal in every lane.
+  bool tx_kept = false;
+  double tx_dl[kLanes] = {}, tx_he[kLanes] = {}, tx_x[kLanes] = {}, tx_gain[kLanes] = {}, tx_dexa[kLanes] = {};
 };
 
 // Delta h's resampling (itm.cpp's delta_h_of): n points p_j = xa + j step, xa >= 0 and the
@@ -74,18 +79,23 @@ struct Counts {
 };
 
 // Each instruction set's copy: the lanes' losses (Lanes' "out" fields) from their geometry,
-// and Delta h's two passes.
+// Delta h's two passes, and its quantiles among the values gathered: kth_extreme, the k-th
+// smallest (0-based; largest: the k-th largest) of c[0..count), count > k, by taking the
+// extreme off count - 1 - k times, four values at a time (for few values beyond the k-th);
+// it reorders c, which has room for count rounded up to kSumParts (the spare places written).
 namespace baseline {
 void evaluate(const Path& p, Lanes& lanes);
 Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s);
 Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
               double* high);
+double kth_extreme(double* c, std::size_t count, std::size_t k, bool largest);
 }  // namespace baseline
 namespace avx2 {
 void evaluate(const Path& p, Lanes& lanes);
 Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s);
 Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
               double* high);
+double kth_extreme(double* c, std::size_t count, std::size_t k, bool largest);
 }  // namespace avx2
 
 }  // namespace terravol::volume::itm_kernel
@@ -128,6 +138,12 @@ inline bool any(I mask) {
     if (mask[k] != 0) return true;
   }
   return false;
+}
+inline bool all(I mask) {
+  for (int k = 0; k < kLanes; ++k) {
+    if (mask[k] == 0) return false;
+  }
+  return true;
 }
 inline V select(I mask, V a, V b) { return mask ? a : b; }
 // The C library's std::min(a, b) and std::max(a, b), lane by lane (the same choice with NaN).
@@ -368,7 +384,21 @@ inline void evaluate_lanes(const Path& p, Lanes& lanes) {
       the[j] = select(los_geometry, angle, the[j]);
     }
   }
-  const Terminal terms[2] = {terminal(dl[0], he[0], dls[0], p), terminal(dl[1], he[1], dls[1], p)};
+  // The transmitter's terms depend on its horizon distance and effective height alone (d_Ls
+  // follows from h_e): those of the last evaluation where both are equal in every lane.
+  Terminal tx;
+  if (lanes.tx_kept && all((dl[0] == load(lanes.tx_dl)) & (he[0] == load(lanes.tx_he)))) {
+    tx = {dls[0], load(lanes.tx_x), load(lanes.tx_gain), load(lanes.tx_dexa)};
+  } else {
+    tx = terminal(dl[0], he[0], dls[0], p);
+    store(lanes.tx_dl, dl[0]);
+    store(lanes.tx_he, he[0]);
+    store(lanes.tx_x, tx.x);
+    store(lanes.tx_gain, tx.gain);
+    store(lanes.tx_dexa, tx.dexa);
+    lanes.tx_kept = true;
+  }
+  const Terminal terms[2] = {tx, terminal(dl[1], he[1], dls[1], p)};
 
   // The reference attenuation (the Algorithm's point-to-point mode at the path's own length).
   const V dlsa = dls[0] + dls[1], dla = dl[0] + dl[1];
@@ -684,8 +714,29 @@ inline Counts beyond_lanes(const double* s, int n, double at0, double slope, dou
 // This copy's entry points (declared above); each file that includes this header with its
 // own TERRAVOL_ITM_KERNEL defines its copy's.
 void evaluate(const Path& p, Lanes& lanes) { evaluate_lanes(p, lanes); }
+template <bool kLargest>
+inline double kth_extreme_lanes(double* c, std::size_t count, std::size_t k) {
+  // The values beyond the k-th smallest lie above it: the largest is taken off (for the k-th
+  // largest, the smallest), exact in any order.
+  auto extreme = [](auto a, auto b) { return kLargest ? (b < a ? b : a) : (a < b ? b : a); };
+  for (std::size_t beyond = count - 1 - k;; --beyond) {
+    for (std::size_t i = count; i % kSumParts != 0; ++i) c[i] = kLargest ? kInf : -kInf;
+    Q top = qload(c);
+    for (std::size_t i = kSumParts; i < count; i += kSumParts) top = extreme(top, qload(c + i));
+    double value = top[0];
+    for (int l = 1; l < kSumParts; ++l) value = extreme(value, top[l]);
+    if (beyond == 0) return value;
+    std::size_t at = 0;
+    while (c[at] != value) ++at;
+    c[at] = c[--count];
+  }
+}
+
 Sums resample(const double* z, int np, int k0, double xa, double step, int n, double* s) {
   return resample_lanes(z, np, k0, xa, step, n, s);
+}
+double kth_extreme(double* c, std::size_t count, std::size_t k, bool largest) {
+  return largest ? kth_extreme_lanes<true>(c, count, k) : kth_extreme_lanes<false>(c, count, k);
 }
 Counts beyond(const double* s, int n, double at0, double slope, double low_threshold, double high_threshold, double* low,
               double* high) {

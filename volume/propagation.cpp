@@ -61,6 +61,7 @@
 
 #include <GeographicLib/Geodesic.hpp>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -594,10 +595,17 @@ RfStats compute_rf_rows(const io::Grid& dem, const Transmitter& tx, const Lattic
   std::mutex progress_mutex;
   int reported = -1;
   const auto t0 = std::chrono::steady_clock::now();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_columns, 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    ColumnModel model(tx, options);
+  // Each thread's model (with its scratch space and Delta h's guesses, which only decide speed),
+  // profile and column, kept from one range of columns to the next.
+  struct Worker {
+    ColumnModel model;
     TerrainProfile profile;
-    std::vector<float> column(static_cast<std::size_t>(nh));
+    std::vector<float> column;
+  };
+  tbb::enumerable_thread_specific<Worker> workers(
+      [&] { return Worker{ColumnModel(tx, options), {}, std::vector<float>(static_cast<std::size_t>(nh))}; });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_columns, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    auto& [model, profile, column] = workers.local();
     std::size_t local_samples = 0, local_warned = 0, local_computed = 0;
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
       const int i = static_cast<int>(c % nx);
