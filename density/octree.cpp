@@ -29,7 +29,10 @@
 // epsilon pixels at its distance is drawn as its faces, a leaf is drawn, and otherwise its
 // children are visited far side first along every axis (a back-to-front order: any two cells of
 // an octree are separated by a plane of their common ancestor, and the far side of it comes
-// first). Departures: the 1995 implementation drew every face and did not cull; the faces that
+// first). With RefineOptions::error_tolerance, a cell whose error (how far its faces are from
+// the columns of children they average, plus its children's: kept per cell at the build) is
+// within it is also drawn while it spans fewer than max_size_px pixels (Laur and Hanrahan's
+// error-bounded levels). Departures: the 1995 implementation drew every face and did not cull; the faces that
 // face the eye are chosen by mrbsp (mrbsp/color_boxes.h), which also orders them with the
 // terrain and the merged surfaces.
 #include "density/octree.h"
@@ -350,11 +353,16 @@ Faces ColorCubeOctree::build_cell(int level, int i, int j, int k) {
     const int ci = 2 * i + (c & 1), cj = 2 * j + ((c >> 1) & 1), ck = 2 * k + (c >> 2);
     child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? build_cell(level - 1, ci, cj, ck) : Faces{};
   }
-  float error = 0.0f;
-  const Faces f = compose(child, dc, i, j, k, options_.compositing, error);
-  packed_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)] = pack(f);
-  errors_[static_cast<std::size_t>(level)][cell_index(level, i, j, k)] = error_byte(error + children_error(level, i, j, k));
+  float deviation = 0.0f;
+  const Faces f = compose(child, dc, i, j, k, options_.compositing, deviation);
+  keep(level, i, j, k, f, deviation);
   return f;
+}
+
+void ColorCubeOctree::keep(int level, int i, int j, int k, const Faces& f, float deviation) {
+  const std::size_t at = cell_index(level, i, j, k);
+  packed_[static_cast<std::size_t>(level)][at] = pack(f);
+  errors_[static_cast<std::size_t>(level)][at] = error_byte(deviation + children_error(level, i, j, k));
 }
 
 float ColorCubeOctree::children_error(int level, int i, int j, int k) const {
@@ -432,11 +440,10 @@ void ColorCubeOctree::build_all() {
             child[c] = ci < dc[0] && cj < dc[1] && ck < dc[2] ? above[static_cast<std::size_t>(lv - 1)][cell_index(lv - 1, ci, cj, ck)]
                                                               : Faces{};
           }
-          float error = 0.0f;
-          const Faces f = compose(child, dc, i, j, k, options_.compositing, error);
+          float deviation = 0.0f;
+          const Faces f = compose(child, dc, i, j, k, options_.compositing, deviation);
           out[cell_index(lv, i, j, k)] = f;
-          packed_[static_cast<std::size_t>(lv)][cell_index(lv, i, j, k)] = pack(f);
-          errors_[static_cast<std::size_t>(lv)][cell_index(lv, i, j, k)] = error_byte(error + children_error(lv, i, j, k));
+          keep(lv, i, j, k, f, deviation);
         }
   }
   build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -134,6 +134,8 @@ class ColorCubeOctree {
   Faces leaf_faces(int i, int j, int k) const;
   Faces build_cell(int level, int i, int j, int k);
   float children_error(int level, int i, int j, int k) const;  // the largest of its children's
+  // Stores a cell's faces (packed) and its error: `deviation` plus its children's.
+  void keep(int level, int i, int j, int k, const Faces& f, float deviation);
   bool maybe_filled(int level, int i, int j, int k) const;
   std::size_t cell_index(int level, int i, int j, int k) const;
   void build_all();
