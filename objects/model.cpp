@@ -15,13 +15,17 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
-#include <unordered_map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <system_error>
+#include <unordered_map>
 
 #include "io/error.h"
+#include "volume/isolated.h"
+#include "volume/vtk_smp.h"
 
 namespace terravol::objects {
 
@@ -75,40 +79,67 @@ struct Texture {
 };
 
 // The image a VTK reader decodes, as RGBA bytes (grey, grey and alpha, RGB or RGBA; 8 or 16
-// bits). Empty when it reads nothing. Throws for more than kMaxTexturePixels pixels, checked
-// from the header before the pixels are read.
-std::optional<Texture> decode(vtkImageReader2& reader, const std::string& source, const std::string& name) {
-  reader.UpdateInformation();
-  const int* extent = reader.GetDataExtent();
-  const std::int64_t w = std::int64_t{extent[1]} - extent[0] + 1, h = std::int64_t{extent[3]} - extent[2] + 1;
-  if (w <= 0 || h <= 0) return std::nullopt;
-  if (static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h) > kMaxTexturePixels) {
-    throw io::FormatError(source, "texture '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) +
-                                      " pixels, more than 16384x16384");
+// bits), in an isolated child process (volume/isolated.h): VTK's PNG reader crashes the process
+// on a truncated file (libpng's error jumps out of it), so a bad texture must cost only the
+// child. `make` builds the reader in the child. Empty when it reads nothing or the child fails.
+// Throws for more than kMaxTexturePixels pixels, checked from the header before the pixels are
+// read.
+template <class MakeReader>
+std::optional<Texture> decode(const MakeReader& make, const std::string& source, const std::string& name) {
+  static std::mutex vtk;  // one child at a time: no other thread of ours inside VTK's readers when it forks
+  const std::lock_guard<std::mutex> lock(vtk);
+  const volume::detail::IsolatedRun run = volume::detail::run_isolated(
+      [&]() -> std::string {
+        volume::detail::use_sequential_vtk_smp();  // no TBB in the child
+        vtkSmartPointer<vtkImageReader2> reader = make();
+        if (!reader) return "none";
+        reader->UpdateInformation();
+        const int* extent = reader->GetDataExtent();
+        const std::int64_t w = std::int64_t{extent[1]} - extent[0] + 1, h = std::int64_t{extent[3]} - extent[2] + 1;
+        if (w <= 0 || h <= 0) return "none";
+        if (static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h) > kMaxTexturePixels) {
+          return "large " + std::to_string(w) + "x" + std::to_string(h);
+        }
+        reader->Update();
+        vtkImageData* image = reader->GetOutput();
+        const int* dims = image->GetDimensions();
+        const int n = image->GetNumberOfScalarComponents();
+        const int type = image->GetScalarType();
+        if (dims[0] != w || dims[1] != h || n < 1 || n > 4 || (type != VTK_UNSIGNED_CHAR && type != VTK_UNSIGNED_SHORT)) return "none";
+        const std::size_t pixels = static_cast<std::size_t>(w * h);
+        std::string out = "rgba " + std::to_string(w) + " " + std::to_string(h) + "\n";
+        const std::size_t header = out.size();
+        out.resize(header + 4 * pixels);
+        const void* data = image->GetScalarPointer();
+        for (std::size_t p = 0; p < pixels; ++p) {
+          std::array<std::uint8_t, 4> in{0, 0, 0, 255};
+          for (int c = 0; c < n; ++c) {
+            const std::size_t at = p * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
+            in[static_cast<std::size_t>(c)] = type == VTK_UNSIGNED_CHAR ? static_cast<const std::uint8_t*>(data)[at]
+                                                                        : static_cast<std::uint8_t>(static_cast<const std::uint16_t*>(data)[at] >> 8);
+          }
+          const bool grey = n <= 2;
+          const std::array<std::uint8_t, 4> rgba{in[0], grey ? in[0] : in[1], grey ? in[0] : in[2],
+                                                 n == 2 ? in[1] : n == 4 ? in[3] : std::uint8_t{255}};
+          std::memcpy(out.data() + header + 4 * p, rgba.data(), 4);
+        }
+        return out;
+      },
+      // Room for the decoded image and its RGBA copy at the largest size allowed.
+      std::size_t{9} * kMaxTexturePixels + (std::size_t{512} << 20), 120.0);
+  if (!run.ok) return std::nullopt;
+  const std::string& out = run.output;
+  if (out.rfind("large ", 0) == 0) {
+    throw io::FormatError(source, "texture '" + name + "' is " + out.substr(6) + " pixels, more than 16384x16384");
   }
-  reader.Update();
-  vtkImageData* image = reader.GetOutput();
-  const int* dims = image->GetDimensions();
-  const int n = image->GetNumberOfScalarComponents();
-  const int type = image->GetScalarType();
-  if (dims[0] != w || dims[1] != h || n < 1 || n > 4 || (type != VTK_UNSIGNED_CHAR && type != VTK_UNSIGNED_SHORT)) return std::nullopt;
   Texture t;
-  t.width = static_cast<int>(w);
-  t.height = static_cast<int>(h);
-  const std::size_t pixels = static_cast<std::size_t>(w * h);
-  t.rgba.resize(4 * pixels);
-  const void* data = image->GetScalarPointer();
-  for (std::size_t p = 0; p < pixels; ++p) {
-    std::array<std::uint8_t, 4> in{0, 0, 0, 255};
-    for (int c = 0; c < n; ++c) {
-      const std::size_t at = p * static_cast<std::size_t>(n) + static_cast<std::size_t>(c);
-      in[static_cast<std::size_t>(c)] = type == VTK_UNSIGNED_CHAR ? static_cast<const std::uint8_t*>(data)[at]
-                                                                  : static_cast<std::uint8_t>(static_cast<const std::uint16_t*>(data)[at] >> 8);
-    }
-    const bool grey = n <= 2;
-    const std::array<std::uint8_t, 4> rgba{in[0], grey ? in[0] : in[1], grey ? in[0] : in[2], n == 2 ? in[1] : n == 4 ? in[3] : std::uint8_t{255}};
-    std::copy(rgba.begin(), rgba.end(), t.rgba.begin() + static_cast<std::ptrdiff_t>(4 * p));
+  const std::size_t eol = out.find('\n');
+  if (out.rfind("rgba ", 0) != 0 || eol == std::string::npos ||
+      std::sscanf(out.c_str() + 5, "%d %d", &t.width, &t.height) != 2 || t.width <= 0 || t.height <= 0 ||
+      out.size() != eol + 1 + 4 * static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height)) {
+    return std::nullopt;
   }
+  t.rgba.assign(out.begin() + static_cast<std::ptrdiff_t>(eol + 1), out.end());
   return t;
 }
 
@@ -128,14 +159,18 @@ std::optional<Texture> material_texture(const aiScene& scene, const aiMaterial& 
   if (const aiTexture* embedded = scene.GetEmbeddedTexture(path.C_Str())) {
     if (embedded->mHeight == 0) {  // a compressed file in memory, mWidth bytes
       const std::string hint = embedded->achFormatHint;
-      vtkSmartPointer<vtkImageReader2> reader;
-      if (hint == "png") reader = vtkSmartPointer<vtkPNGReader>::New();
-      if (hint == "jpg" || hint == "jpeg") reader = vtkSmartPointer<vtkJPEGReader>::New();
-      if (reader) {
-        reader->SetMemoryBuffer(embedded->pcData);
-        reader->SetMemoryBufferLength(embedded->mWidth);
-        texture = decode(*reader, source, name);
-      }
+      texture = decode(
+          [&]() -> vtkSmartPointer<vtkImageReader2> {
+            vtkSmartPointer<vtkImageReader2> reader;
+            if (hint == "png") reader = vtkSmartPointer<vtkPNGReader>::New();
+            if (hint == "jpg" || hint == "jpeg") reader = vtkSmartPointer<vtkJPEGReader>::New();
+            if (reader) {
+              reader->SetMemoryBuffer(embedded->pcData);
+              reader->SetMemoryBufferLength(embedded->mWidth);
+            }
+            return reader;
+          },
+          source, name);
     } else if (static_cast<std::uint64_t>(embedded->mWidth) * embedded->mHeight <= kMaxTexturePixels) {
       // Raw texels, the first row at the top.
       Texture t;
@@ -159,12 +194,14 @@ std::optional<Texture> material_texture(const aiScene& scene, const aiMaterial& 
     const std::filesystem::path file = model.parent_path() / relative;
     std::error_code ec;
     if (std::filesystem::is_regular_file(file, ec)) {
-      vtkSmartPointer<vtkImageReader2> reader;
-      reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(file.string().c_str()));
-      if (reader) {
-        reader->SetFileName(file.string().c_str());
-        texture = decode(*reader, source, name);
-      }
+      texture = decode(
+          [&]() -> vtkSmartPointer<vtkImageReader2> {
+            vtkSmartPointer<vtkImageReader2> reader;
+            reader.TakeReference(vtkImageReader2Factory::CreateImageReader2(file.string().c_str()));
+            if (reader) reader->SetFileName(file.string().c_str());
+            return reader;
+          },
+          source, name);
     }
   }
   if (!texture && std::find(missing.begin(), missing.end(), name) == missing.end()) missing.push_back(name);

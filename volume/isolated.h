@@ -1,7 +1,7 @@
 // Running a parser that is not safe on hostile input (OpenVDB's reader corrupts the heap or
 // crashes on some corrupt files: tests/volume/readers_test.cpp, VdbHostile) in a child
 // process, so that a bad file costs an error message instead of the process.
-// Private to volume/.
+// Private to volume/, and objects/ (textures decoded by VTK).
 #pragma once
 
 #include <cstddef>

@@ -169,6 +169,24 @@ TEST(Model, AMissingTextureLeavesTheMaterialsColourAndIsReported) {
   for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 0, 255, 255));
 }
 
+// A PNG cut short after its header (its header's checksum wrong too): VTK's PNG reader takes
+// the process down on it (libpng's error jumps out of it), so the texture is decoded in a
+// child process, and this costs a warning, not the process.
+TEST(Model, ATruncatedPngTextureLeavesTheMaterialsColour) {
+  test::TempDir dir;
+  const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + std::string("\0\0\0\x0dIHDR", 8) +
+                          std::string("\0\0\0\x02\0\0\0\x02\x08\x02\0\0\0", 13) + std::string("\x01\x02\x03\x04", 4) +
+                          std::string("\0\0\0\x10IDAT", 8);
+  write(dir.path() / "cut.png", png);
+  write(dir.path() / "m.mtl", "newmtl textured\nKd 0 1 0\nmap_Kd cut.png\n");
+  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
+  const Model m = read_model(dir.path() / "m.obj");
+  EXPECT_EQ(m.textured_meshes, 0u);
+  ASSERT_EQ(m.missing_textures.size(), 1u);
+  EXPECT_EQ(m.missing_textures[0], "cut.png");
+  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 255, 0, 255));
+}
+
 // A texture whose header claims 10^10 pixels is refused from its header, naming the model and
 // the texture.
 TEST(Model, AnAbsurdlyLargeTextureIsRefusedFromItsHeader) {
