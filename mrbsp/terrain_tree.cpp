@@ -1187,54 +1187,49 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   const std::size_t chunks = box_order || estimate < options.parallel_min_triangles
                                  ? 1
                                  : std::min<std::size_t>(leaves.size(), 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()));
-  if (chunks <= 1) {
-    Sink out{frame.indices, frame.level, frame.leaf_stack_};
+  // Chunk c writes leaves [cut[c], cut[c + 1]); chunk 0 into the frame's own buffers, the
+  // others into their scratch, joined after it in order. One chunk is the serial pass.
+  auto& cut = frame.chunk_cuts_;
+  cut.assign(chunks + 1, leaves.size());
+  cut[0] = 0;
+  std::size_t so_far = 0, next = 1;
+  for (std::size_t k = 0; k < leaves.size() && next < chunks; ++k) {
+    so_far += estimate_of(leaves[k]);
+    while (next < chunks && so_far * chunks >= estimate * next) cut[next++] = k + 1;
+  }
+  if (frame.chunks_.size() < chunks) frame.chunks_.resize(chunks);
+  const auto run_chunk = [&](std::size_t c) {
+    Frame::EmitChunk& chunk = frame.chunks_[c];
+    Sink out{c == 0 ? frame.indices : chunk.indices, c == 0 ? frame.level : chunk.level, chunk.stack};
     out.open();
-    for (const std::uint64_t item : leaves) emit_item(out, item);
-    frame.indices.resize(3 * out.triangles);
-    frame.level.resize(out.triangles);
-    frame.crack_triangles = out.cracks;
+    for (std::size_t k = cut[c]; k < cut[c + 1]; ++k) emit_item(out, leaves[k]);
+    chunk.triangles = out.triangles;
+    chunk.crack_triangles = out.cracks;
+  };
+  if (chunks == 1) {
+    run_chunk(0);
   } else {
-    std::vector<std::size_t> cut(chunks + 1, leaves.size());  // chunk c: leaves [cut[c], cut[c + 1])
-    cut[0] = 0;
-    std::size_t so_far = 0, next = 1;
-    for (std::size_t k = 0; k < leaves.size() && next < chunks; ++k) {
-      so_far += estimate_of(leaves[k]);
-      while (next < chunks && so_far * chunks >= estimate * next) cut[next++] = k + 1;
-    }
-    if (frame.chunks_.size() < chunks - 1) frame.chunks_.resize(chunks - 1);
-    std::vector<Sink> sinks;
-    sinks.reserve(chunks);
-    sinks.push_back({frame.indices, frame.level, frame.leaf_stack_});
-    for (std::size_t c = 1; c < chunks; ++c) {
-      Frame::EmitChunk& chunk = frame.chunks_[c - 1];
-      sinks.push_back({chunk.indices, chunk.level, chunk.stack});
-    }
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, chunks, 1),
         [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t c = range.begin(); c != range.end(); ++c) {
-            sinks[c].open();
-            for (std::size_t k = cut[c]; k < cut[c + 1]; ++k) emit_item(sinks[c], leaves[k]);
-          }
+          for (std::size_t c = range.begin(); c != range.end(); ++c) run_chunk(c);
         },
         tbb::simple_partitioner());
-    std::size_t total = 0;
-    frame.crack_triangles = 0;
-    for (const Sink& sink : sinks) {
-      total += sink.triangles;
-      frame.crack_triangles += sink.cracks;
-    }
-    const std::size_t first = sinks[0].triangles;
-    frame.indices.resize(3 * total);  // keeps the first chunk's triangles in place
-    frame.level.resize(total);
-    std::size_t at = first;
-    for (std::size_t c = 1; c < chunks; ++c) {
-      const Sink& sink = sinks[c];
-      std::copy_n(sink.indices.begin(), 3 * sink.triangles, frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * at));
-      std::copy_n(sink.level.begin(), sink.triangles, frame.level.begin() + static_cast<std::ptrdiff_t>(at));
-      at += sink.triangles;
-    }
+  }
+  std::size_t total = 0;
+  frame.crack_triangles = 0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    total += frame.chunks_[c].triangles;
+    frame.crack_triangles += frame.chunks_[c].crack_triangles;
+  }
+  std::size_t at = frame.chunks_[0].triangles;
+  frame.indices.resize(3 * total);  // keeps the first chunk's triangles in place
+  frame.level.resize(total);
+  for (std::size_t c = 1; c < chunks; ++c) {
+    const Frame::EmitChunk& chunk = frame.chunks_[c];
+    std::copy_n(chunk.indices.begin(), 3 * chunk.triangles, frame.indices.begin() + static_cast<std::ptrdiff_t>(3 * at));
+    std::copy_n(chunk.level.begin(), chunk.triangles, frame.level.begin() + static_cast<std::ptrdiff_t>(at));
+    at += chunk.triangles;
   }
   if (box_order) frame.boxes = box_order->stats;
 }

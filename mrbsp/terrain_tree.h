@@ -181,8 +181,8 @@ struct Frame {
     std::uint64_t item;  // the walk's: an outside slot, or a bucket of colour boxes
   };
   std::vector<OutsideOrder> outside_places_;
-  std::vector<std::uint64_t> leaf_stack_;
-  // The last pass's chunks after the first (which writes into indices and level directly).
+  // The last pass's chunks of the draw order: each one's small-BSP stack and counts, and for
+  // every chunk after the first (which writes into indices and level) its triangles.
   struct EmitChunk {
     std::vector<std::uint32_t> indices;
     std::vector<std::int8_t> level;
@@ -190,6 +190,7 @@ struct Frame {
     std::size_t triangles = 0, crack_triangles = 0;
   };
   std::vector<EmitChunk> chunks_;
+  std::vector<std::size_t> chunk_cuts_;  // chunk c: leaves_[chunk_cuts_[c], chunk_cuts_[c + 1])
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found

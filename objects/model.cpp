@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -84,8 +85,8 @@ struct Texture {
 // child. `make` builds the reader in the child. Empty when it reads nothing or the child fails.
 // Throws for more than kMaxTexturePixels pixels, checked from the header before the pixels are
 // read.
-template <class MakeReader>
-std::optional<Texture> decode(const MakeReader& make, const std::string& source, const std::string& name) {
+std::optional<Texture> decode(const std::function<vtkSmartPointer<vtkImageReader2>()>& make, const std::string& source,
+                              const std::string& name) {
   static std::mutex vtk;  // one child at a time: no other thread of ours inside VTK's readers when it forks
   const std::lock_guard<std::mutex> lock(vtk);
   const volume::detail::IsolatedRun run = volume::detail::run_isolated(
@@ -208,6 +209,20 @@ std::optional<Texture> material_texture(const aiScene& scene, const aiMaterial& 
   return texture;
 }
 
+// A vertex of a mesh as the weld sees it: the bits of the position's floats (as the file gives
+// them) and the colour's bytes.
+struct WeldKey {
+  std::array<std::uint32_t, 4> bits;
+  bool operator==(const WeldKey&) const = default;
+  struct Hash {
+    std::size_t operator()(const WeldKey& k) const {
+      std::uint64_t h = 0x9E3779B97F4A7C15ull;
+      for (const std::uint32_t b : k.bits) h = (h ^ b) * 0xBF58476D1CE4E5B9ull;
+      return static_cast<std::size_t>(h ^ (h >> 31));
+    }
+  };
+};
+
 struct Collector {
   const aiScene* scene;
   const std::string& source;
@@ -239,7 +254,7 @@ struct Collector {
     }
     // Vertices with the same position and colour are one (texture coordinates told them apart
     // while the texture was sampled).
-    std::unordered_map<std::string, std::uint32_t> welded;  // key: the position's floats and the colour's bytes
+    std::unordered_map<WeldKey, std::uint32_t, WeldKey::Hash> welded;
     std::vector<std::uint32_t> index(a->mNumVertices);
     for (unsigned v = 0; v < a->mNumVertices; ++v) {
       const aiVector3D p = m * a->mVertices[v];
@@ -255,11 +270,11 @@ struct Collector {
       }
       const std::array<std::uint8_t, 4> rgba{byte_of(c.r), byte_of(c.g), byte_of(c.b), byte_of(c.a)};
       const aiVector3D& at = a->mVertices[v];
-      std::string key(16, '\0');
+      WeldKey key{};
       const float xyz[3] = {at.x, at.y, at.z};
-      std::memcpy(key.data(), xyz, 12);
-      std::memcpy(key.data() + 12, rgba.data(), 4);
-      const auto [it, fresh] = welded.try_emplace(std::move(key), static_cast<std::uint32_t>(out.vertices.size()));
+      std::memcpy(key.bits.data(), xyz, 12);
+      std::memcpy(&key.bits[3], rgba.data(), 4);
+      const auto [it, fresh] = welded.try_emplace(key, static_cast<std::uint32_t>(out.vertices.size()));
       index[v] = it->second;
       if (!fresh) continue;
       out.vertices.emplace_back(p.x, p.y, p.z);

@@ -20,6 +20,27 @@ namespace {
 
 using test::geographic_volume;
 
+// A camera at `offset` from the centre of the octree's boxes, looking at it, `width` x `height`.
+mrbsp::Camera looking_at_centre(const BoxGrid& g, const glm::dvec3& offset, int width, int height) {
+  const glm::dvec3 centre = g.origin + 0.5 * g.size * glm::dvec3(g.boxes[0], g.boxes[1], g.boxes[2]);
+  mrbsp::Camera c;
+  c.eye = centre + offset;
+  c.forward = glm::normalize(centre - c.eye);
+  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+// A drawn box's largest side in pixels from `c` at its nearest point, or 0 for a leaf.
+double size_above_leaves_px(const mrbsp::ColorBox& b, const BoxGrid& g, const mrbsp::Camera& c) {
+  const glm::dvec3 lo(b.lo), hi(b.hi);
+  const bool leaf = hi.x - lo.x <= g.size.x * 1.001 && hi.y - lo.y <= g.size.y * 1.001 && hi.z - lo.z <= g.size.z * 1.001;
+  if (leaf) return 0.0;
+  const double focal = c.height * 0.5 / std::tan(glm::radians(c.fov_y_deg) * 0.5);
+  return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) * focal / glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
+}
+
 // A medium of one value everywhere (heights above a ground that cancels the curvature drop, so
 // that every column's layers lie at the same scene heights): every cell's face has the opacity
 // of its extent along the face's normal, at every level, cut to the volume or not.
@@ -206,14 +227,7 @@ TEST(Octree, RefinementDrawsCellsBelowEpsilonAndEveryLeafWhenAsked) {
   const volume::Volume v = test::path_loss_volume(33, 25, 11, false);
   const ColorCubeOctree o(v, frame, {}, parse_density("range=80:150,colormap=viridis,opacity=1"));
   const BoxGrid& g = o.grid();
-  const glm::dvec3 centre = g.origin + 0.5 * g.size * glm::dvec3(g.boxes[0], g.boxes[1], g.boxes[2]);
-  mrbsp::Camera c;
-  c.eye = centre + glm::dvec3(-36000.0, -48000.0, 24000.0);
-  c.forward = glm::normalize(centre - c.eye);
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
-  c.width = 640;
-  c.height = 360;
-  const double focal = c.height * 0.5 / std::tan(glm::radians(c.fov_y_deg) * 0.5);
+  const mrbsp::Camera c = looking_at_centre(g, {-36000.0, -48000.0, 24000.0}, 640, 360);
   std::size_t last = 0;
   for (double eps : {64.0, 16.0, 4.0, 1.0}) {
     std::vector<mrbsp::ColorBox> boxes;
@@ -221,14 +235,7 @@ TEST(Octree, RefinementDrawsCellsBelowEpsilonAndEveryLeafWhenAsked) {
     o.refine(c, RefineOptions{eps, false, true}, boxes, stats);
     EXPECT_GT(boxes.size(), last) << "epsilon " << eps;
     last = boxes.size();
-    for (const mrbsp::ColorBox& b : boxes) {
-      const glm::dvec3 lo(b.lo), hi(b.hi);
-      const bool leaf = hi.x - lo.x <= g.size.x * 1.001 && hi.y - lo.y <= g.size.y * 1.001 && hi.z - lo.z <= g.size.z * 1.001;
-      if (leaf) continue;
-      const double dist = glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
-      const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) * focal / dist;
-      EXPECT_LT(size, eps);
-    }
+    for (const mrbsp::ColorBox& b : boxes) EXPECT_LT(size_above_leaves_px(b, g, c), eps);
   }
   std::vector<mrbsp::ColorBox> all;
   RefineStats stats;
@@ -278,15 +285,7 @@ TEST(Octree, ACellsErrorMeasuresHowUnlikeItsChildrenAreAndBoundsItsSubtree) {
   // Refinement: a seeded path-loss field from a near camera.
   const volume::Volume field = test::path_loss_volume(33, 25, 11, false);
   const ColorCubeOctree p(field, frame, {}, parse_density("range=80:150,colormap=viridis,opacity=1"));
-  const BoxGrid& g = p.grid();
-  const glm::dvec3 centre = g.origin + 0.5 * g.size * glm::dvec3(g.boxes[0], g.boxes[1], g.boxes[2]);
-  mrbsp::Camera c;
-  c.eye = centre + glm::dvec3(-3600.0, -4800.0, 2400.0);
-  c.forward = glm::normalize(centre - c.eye);
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
-  c.width = 640;
-  c.height = 360;
-  const double focal = c.height * 0.5 / std::tan(glm::radians(c.fov_y_deg) * 0.5);
+  const mrbsp::Camera c = looking_at_centre(p.grid(), {-3600.0, -4800.0, 2400.0}, 640, 360);
   std::size_t last = std::numeric_limits<std::size_t>::max();
   for (const double tolerance : {0.0, 2.0 / 255.0, 8.0 / 255.0, 32.0 / 255.0}) {
     RefineOptions options;
@@ -297,12 +296,7 @@ TEST(Octree, ACellsErrorMeasuresHowUnlikeItsChildrenAreAndBoundsItsSubtree) {
     EXPECT_LE(boxes.size(), last) << "tolerance " << tolerance * 255.0;
     last = boxes.size();
     for (const mrbsp::ColorBox& b : boxes) {
-      const glm::dvec3 lo(b.lo), hi(b.hi);
-      const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}) * focal / glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
-      const bool leaf = hi.x - lo.x <= g.size.x * 1.001 && hi.y - lo.y <= g.size.y * 1.001 && hi.z - lo.z <= g.size.z * 1.001;
-      if (!leaf) {
-        EXPECT_LT(size, tolerance > 0.0 ? options.max_size_px : options.threshold_px);
-      }
+      EXPECT_LT(size_above_leaves_px(b, p.grid(), c), tolerance > 0.0 ? options.max_size_px : options.threshold_px);
     }
   }
   EXPECT_LT(last, 100000u);
@@ -317,12 +311,8 @@ TEST(Octree, AFarViewDrawsAboutAsManyCellsWhenTheLatticeIsRefined) {
   const DensitySpec spec = parse_density("range=80:150,colormap=viridis,opacity=1");
   const ColorCubeOctree a(coarse, frame, {}, spec), b(fine, frame, {}, spec);
   EXPECT_EQ(b.levels(), a.levels() + 1);
-  const BoxGrid& g = a.grid();
-  const glm::dvec3 centre = g.origin + 0.5 * g.size * glm::dvec3(g.boxes[0], g.boxes[1], g.boxes[2]);
-  mrbsp::Camera c;
-  c.eye = centre + glm::dvec3(-300000.0, -400000.0, 200000.0);  // leaves of the coarse lattice well below a pixel
-  c.forward = glm::normalize(centre - c.eye);
-  c.up = glm::normalize(glm::cross(glm::cross(c.forward, glm::dvec3(0, 0, 1)), c.forward));
+  // Leaves of the coarse lattice well below a pixel.
+  const mrbsp::Camera c = looking_at_centre(a.grid(), {-300000.0, -400000.0, 200000.0}, 1280, 720);
   std::vector<mrbsp::ColorBox> ba, bb;
   RefineStats sa, sb;
   a.refine(c, RefineOptions{1.0, false, true}, ba, sa);

@@ -169,7 +169,8 @@ TEST(Merge, ALargeSurfaceSentInChunksDrawsItsWholeVisibleAreaInOrder) {
 
 // The last pass of a traversal writes large frames in parallel chunks of the draw order and
 // joins them: from random eyes, with and without culling, back to front and front to back,
-// the chunked frame is the serial one triangle for triangle, with the same crack fills.
+// the chunked frame keeps the brute-force ray order and is the serial one triangle for
+// triangle, with the same crack fills.
 TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
   std::mt19937 rng(19);
   TestWindow w(16, [](int, int) { return 0.0f; });
@@ -190,6 +191,8 @@ TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
     tree.traverse(c, o, serial);
     o.parallel_min_triangles = 0;
     tree.traverse(c, o, chunked);
+    // Against the brute-force ray order too, which the serial frame is held to elsewhere.
+    EXPECT_EQ(order_violations(tree, chunked, eye, 40, rng, !o.front_to_back), 0) << "trial " << trial;
     ASSERT_EQ(chunked.indices, serial.indices) << "trial " << trial;
     EXPECT_EQ(chunked.level, serial.level) << "trial " << trial;
     EXPECT_EQ(chunked.crack_triangles, serial.crack_triangles) << "trial " << trial;

@@ -127,6 +127,14 @@ TEST(Model, ObjMaterialColourAndOpacity) {
   for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(255, 0, 0, 128));
 }
 
+// m.obj in `dir`: one triangle with texture coordinates, its material in m.mtl: `colour` (an
+// MTL line, or empty) and the diffuse texture `texture`.
+std::filesystem::path textured_triangle(const test::TempDir& dir, const std::string& colour, const std::string& texture) {
+  write(dir.path() / "m.mtl", "newmtl textured\n" + colour + "map_Kd " + texture + "\n");
+  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
+  return dir.path() / "m.obj";
+}
+
 // A 2 x 2 texture (a binary PPM beside the model: its first row is the image's top) on a
 // quad whose texture coordinates lie on the texels' centres: each corner takes its texel's
 // colour times the material's (v = 0 is the image's bottom row).
@@ -156,35 +164,23 @@ TEST(Model, TextureColoursAreSampledAtTheVerticesTextureCoordinates) {
   for (const auto& c : read_model(dir.path() / "h.obj").mesh.colors) EXPECT_EQ(c, glm::u8vec4(128, 128, 0, 255));
 }
 
-// A texture the material names but that is not there: the material's colour, and its name
-// reported.
-TEST(Model, AMissingTextureLeavesTheMaterialsColourAndIsReported) {
-  test::TempDir dir;
-  write(dir.path() / "m.mtl", "newmtl textured\nKd 0 0 1\nmap_Kd gone.png\n");
-  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
-  const Model m = read_model(dir.path() / "m.obj");
-  EXPECT_EQ(m.textured_meshes, 0u);
-  ASSERT_EQ(m.missing_textures.size(), 1u);
-  EXPECT_EQ(m.missing_textures[0], "gone.png");
-  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 0, 255, 255));
-}
-
-// A PNG cut short after its header (its header's checksum wrong too): VTK's PNG reader takes
-// the process down on it (libpng's error jumps out of it), so the texture is decoded in a
-// child process, and this costs a warning, not the process.
-TEST(Model, ATruncatedPngTextureLeavesTheMaterialsColour) {
-  test::TempDir dir;
-  const std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + std::string("\0\0\0\x0dIHDR", 8) +
+// A texture the material names that cannot be read: absent, or a PNG cut short after its
+// header (its checksum wrong too; VTK's PNG reader takes the process down on it, libpng's
+// error jumping out of it, so textures are decoded in a child process). Either costs a
+// warning, not the model: the material's colour, and the texture's name reported.
+TEST(Model, ATextureThatCannotBeReadLeavesTheMaterialsColourAndIsReported) {
+  const std::string cut = std::string("\x89PNG\r\n\x1a\n", 8) + std::string("\0\0\0\x0dIHDR", 8) +
                           std::string("\0\0\0\x02\0\0\0\x02\x08\x02\0\0\0", 13) + std::string("\x01\x02\x03\x04", 4) +
                           std::string("\0\0\0\x10IDAT", 8);
-  write(dir.path() / "cut.png", png);
-  write(dir.path() / "m.mtl", "newmtl textured\nKd 0 1 0\nmap_Kd cut.png\n");
-  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
-  const Model m = read_model(dir.path() / "m.obj");
-  EXPECT_EQ(m.textured_meshes, 0u);
-  ASSERT_EQ(m.missing_textures.size(), 1u);
-  EXPECT_EQ(m.missing_textures[0], "cut.png");
-  for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 255, 0, 255));
+  for (const auto& [name, bytes] : {std::pair<std::string, std::string>{"gone.png", ""}, {"cut.png", cut}}) {
+    test::TempDir dir;
+    if (!bytes.empty()) write(dir.path() / name, bytes);
+    const Model m = read_model(textured_triangle(dir, "Kd 0 1 0\n", name));
+    EXPECT_EQ(m.textured_meshes, 0u) << name;
+    ASSERT_EQ(m.missing_textures.size(), 1u) << name;
+    EXPECT_EQ(m.missing_textures[0], name);
+    for (const auto& c : m.mesh.colors) EXPECT_EQ(c, glm::u8vec4(0, 255, 0, 255)) << name;
+  }
 }
 
 // A texture whose header claims 10^10 pixels is refused from its header, naming the model and
@@ -192,10 +188,8 @@ TEST(Model, ATruncatedPngTextureLeavesTheMaterialsColour) {
 TEST(Model, AnAbsurdlyLargeTextureIsRefusedFromItsHeader) {
   test::TempDir dir;
   write(dir.path() / "big.ppm", "P6\n100000 100000\n255\n\x01\x02\x03");
-  write(dir.path() / "m.mtl", "newmtl textured\nmap_Kd big.ppm\n");
-  write(dir.path() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl textured\nf 1/1 2/2 3/3\n");
   try {
-    read_model(dir.path() / "m.obj");
+    read_model(textured_triangle(dir, "", "big.ppm"));
     FAIL() << "an absurd texture was read";
   } catch (const io::FormatError& e) {
     const std::string what = e.what();
