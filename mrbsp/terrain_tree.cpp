@@ -455,6 +455,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // Set once the boxes are distributed (after the occlusion pass): the walk of pass 4 then
   // puts their buckets in its order.
   BoxScratch* box_order = nullptr;
+  const std::size_t previous_nodes = frame.nodes_visited;
   frame.nodes_visited = 0;
   frame.leaves = 0;
   frame.crack_triangles = 0;
@@ -517,23 +518,24 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   const auto in_view = [&](const Box& b) { return !options.cull || !box_outside(planes, b.content_lo(), b.content_hi()); };
 
   // Pass 1, the LOD choice (sections 5 and 5.1): every cell in view, refined while the metric
-  // asks; the drawn cells listed by level.
-  auto& stack = frame.stack_;
+  // asks; the drawn cells listed by level. A cell's decision depends on the camera and the
+  // cell alone, so subtrees are decided apart: below LOD level 1 in parallel, when the last
+  // traversal into this Frame visited TraversalOptions::parallel_min_nodes cells or more.
+  // The marks (what pass 2 and the walk read) are the serial ones; only the order of the
+  // by_level lists differs, and pass 2's refinements do not depend on it (each one refines a
+  // drawn cell toward a neighbour, whichever comes first).
   auto& by_level = frame.by_level_;
   by_level.resize(static_cast<std::size_t>(m.levels));
   for (auto& l : by_level) l.clear();
-  // Items carry the frustum planes their box still has to be tested against (bits 52-56).
-  stack.clear();
-  stack.push_back(pack(kSquare, 0, 0, 0) | std::uint64_t{31} << 52);
-  while (!stack.empty()) {
-    const std::uint64_t item = stack.back();
-    stack.pop_back();
+  // Decides the cell of `item`: listed in `lists` when drawn, its children pushed onto `st`
+  // when refined. Items carry the frustum planes their box still has to be tested against
+  // (bits 52-56).
+  const auto decide = [&](std::uint64_t item, std::vector<std::uint64_t>& st, std::vector<std::vector<std::uint64_t>>& lists) {
     const int level = level_index_of(item) - m.top, ci = ci_of(item), cj = cj_of(item);
-    ++frame.nodes_visited;
     const CellZ cz = m.cell_z(level, ci, cj);
     const Box box = box_of(level, ci, cj, cz);
     const int planes_left = options.cull ? box_planes(planes, box.content_lo(), box.content_hi(), static_cast<int>(item >> 52) & 31) : 0;
-    if (planes_left < 0) continue;
+    if (planes_left < 0) return;
     bool refine = level < m.levels - 1;
     if (level >= 0 && refine && !options.full_res) {
       if (options.metric == LodMetric::kError) {
@@ -545,12 +547,55 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
     if (level >= 0) marks[m.cell_id(level, ci, cj)] = stamp | (refine ? kRefined : kDrawn);
     if (!refine) {
-      by_level[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
-      continue;
+      lists[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
+      return;
     }
     for (int k = 0; k < 4; ++k) {
-      stack.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)) |
-                      static_cast<std::uint64_t>(planes_left) << 52);
+      st.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)) |
+                   static_cast<std::uint64_t>(planes_left) << 52);
+    }
+  };
+  auto& stack = frame.stack_;
+  stack.clear();
+  stack.push_back(pack(kSquare, 0, 0, 0) | std::uint64_t{31} << 52);
+  // The level index whose items become subtrees of their own (none: -1).
+  const int split = m.levels > 1 && previous_nodes >= options.parallel_min_nodes ? m.top + 1 : -1;
+  auto& roots = frame.subtree_roots_;
+  roots.clear();
+  while (!stack.empty()) {
+    const std::uint64_t item = stack.back();
+    stack.pop_back();
+    if (level_index_of(item) == split) {
+      roots.push_back(item);
+      continue;
+    }
+    ++frame.nodes_visited;
+    decide(item, stack, by_level);
+  }
+  if (!roots.empty()) {
+    if (frame.subtrees_.size() < roots.size()) frame.subtrees_.resize(roots.size());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, roots.size(), 1),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            Frame::Subtree& sub = frame.subtrees_[k];
+            sub.by_level.resize(static_cast<std::size_t>(m.levels));
+            for (auto& l : sub.by_level) l.clear();
+            sub.nodes = 0;
+            sub.stack.assign(1, roots[k]);
+            while (!sub.stack.empty()) {
+              const std::uint64_t item = sub.stack.back();
+              sub.stack.pop_back();
+              ++sub.nodes;
+              decide(item, sub.stack, sub.by_level);
+            }
+          }
+        },
+        tbb::simple_partitioner());
+    for (std::size_t k = 0; k < roots.size(); ++k) {
+      const Frame::Subtree& sub = frame.subtrees_[k];
+      frame.nodes_visited += sub.nodes;
+      for (std::size_t l = 0; l < by_level.size(); ++l) by_level[l].insert(by_level[l].end(), sub.by_level[l].begin(), sub.by_level[l].end());
     }
   }
 

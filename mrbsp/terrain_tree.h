@@ -87,6 +87,10 @@ struct TraversalOptions {
   // chunks of the draw order, joined in that order, when the frame is estimated to draw at
   // least this many triangles and has no colour boxes; the triangles are the same either way.
   std::size_t parallel_min_triangles = 32768;
+  // The LOD choice decides the subtrees below LOD level 1 in parallel when the previous
+  // traversal into the same Frame visited at least this many cells (a Frame's first is
+  // serial); the choice is the same either way.
+  std::size_t parallel_min_nodes = 4096;
 };
 
 // Frame::level values other than terrain levels (0 coarsest, levels-1 finest).
@@ -192,6 +196,15 @@ struct Frame {
   std::vector<EmitChunk> chunks_;
   std::vector<std::size_t> chunk_cuts_;  // chunk c: leaves_[chunk_cuts_[c], chunk_cuts_[c + 1])
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
+  // The LOD choice's subtrees decided in parallel: their roots, and each one's stack, drawn
+  // cells per level and cells visited.
+  std::vector<std::uint64_t> subtree_roots_;
+  struct Subtree {
+    std::vector<std::uint64_t> stack;
+    std::vector<std::vector<std::uint64_t>> by_level;
+    std::size_t nodes = 0;
+  };
+  std::vector<Subtree> subtrees_;
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it

@@ -205,7 +205,9 @@ void run_render(const RenderOptions& o) {
                                                                       : 0.0},
                     {"merged_bytes", tree.memory().merged},
                     {"geometry_ms", merge.geometry_ms},
-                    {"merge_ms", merge.merge_ms}};
+                    {"merge_ms", merge.merge_ms},
+                    {"merge_distribute_ms", tree.merge_stats().distribute_ms},
+                    {"merge_build_ms", tree.merge_stats().build_ms}};
     j["objects"] = {{"models", objects.models},
                     {"instances", objects.instances},
                     {"full_triangles", objects.full_triangles},

@@ -201,6 +201,44 @@ TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
   EXPECT_GT(merged, 600u);
 }
 
+// The LOD choice decides the subtrees below level 1 in parallel once a Frame's traversals are
+// large: from random eyes over a 64-cell window with merged triangles, with and without
+// culling, under both metrics, the choice made so draws the serial frame triangle for
+// triangle (the same cells visited, drawn and balanced) in the brute-force ray order.
+TEST(Merge, AnLodChoiceDecidedInParallelSubtreesDrawsTheSerialFrame) {
+  std::mt19937 rng(23);
+  TestWindow w(64, [](int, int) { return 0.0f; });
+  TerrainTree tree = hilly_tree(rng, w);
+  Soup soup = random_triangles(rng, 400, {-100.0, 6500.0, -50.0, 500.0, 60.0});
+  tree.merge(soup.v, soup.c, soup.t);
+  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 2500.0), dir(-1.0, 1.0);
+  Frame serial, split;
+  std::size_t balanced = 0, split_frames = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.6 + 0.4 * dir(rng)});
+    TraversalOptions o;
+    o.cull = trial % 3 != 0;
+    o.metric = trial % 4 == 3 ? LodMetric::kArea : LodMetric::kError;
+    o.threshold_px = o.metric == LodMetric::kArea ? 200.0f : 0.5f + static_cast<float>(trial % 3);
+    o.parallel_min_nodes = std::numeric_limits<std::size_t>::max();
+    tree.traverse(c, o, serial);
+    o.parallel_min_nodes = 0;
+    tree.traverse(c, o, split);
+    split_frames += split.subtree_roots_.empty() ? 0 : 1;
+    EXPECT_EQ(order_violations(tree, split, eye, 40, rng, true), 0) << "trial " << trial;
+    ASSERT_EQ(split.indices, serial.indices) << "trial " << trial;
+    EXPECT_EQ(split.level, serial.level) << "trial " << trial;
+    EXPECT_EQ(split.nodes_visited, serial.nodes_visited) << "trial " << trial;
+    EXPECT_EQ(split.lod_histogram, serial.lod_histogram) << "trial " << trial;
+    EXPECT_EQ(split.balanced_cells, serial.balanced_cells) << "trial " << trial;
+    EXPECT_EQ(split.crack_triangles, serial.crack_triangles) << "trial " << trial;
+    balanced += serial.balanced_cells;
+  }
+  EXPECT_GT(balanced, 0u) << "the balance pass must be exercised";
+  EXPECT_GT(split_frames, 16u) << "and the split, where some level-0 cell in view is refined";
+}
+
 // Culling by content boxes: from cameras inside and beside the merged triangles, low over the
 // ground and looking up, down and level, the merged area drawn inside the view frustum is the
 // input's visible area inside it (the reference clips the inputs to the frustum, derived by
