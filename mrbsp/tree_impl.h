@@ -269,7 +269,14 @@ struct TerrainTree::Impl {
   std::uint32_t merged_base() const { return lattice_count() + static_cast<std::uint32_t>(8 * (n + 1)); }
   float z(int i, int j) const { return positions[vertex(i, j)].z; }
   // The figures of a cell at any level >= -top; the finest level's from its four samples.
-  CellZ cell_z(int level, int ci, int cj) const;
+  // Inline: the traversal's LOD choice asks it of every cell it visits.
+  CellZ cell_z(int level, int ci, int cj) const {
+    if (level == levels - 1) {
+      const float a = z(ci, cj), b = z(ci + 1, cj), c = z(ci, cj + 1), d = z(ci + 1, cj + 1);
+      return {std::min(std::min(a, b), std::min(c, d)), std::max(std::max(a, b), std::max(c, d)), 0.0f};
+    }
+    return cellz[cellz_offset[static_cast<std::size_t>(level + top)] + static_cast<std::size_t>(cj * cells_at(level) + ci)];
+  }
 
   // A rectangle of the lattice, samples [i0, i1] x [j0, j1] (window indices).
   struct Region {
