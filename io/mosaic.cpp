@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <optional>
 #include <system_error>
 
 #include "io/compressed.h"
@@ -9,6 +11,8 @@
 #include "io/geographic.h"
 #include "io/sdf_name.h"
 #include "io/srtm_write.h"
+
+#include <tbb/parallel_for.h>
 
 namespace terravol::io {
 
@@ -211,16 +215,25 @@ const Grid& Mosaic::tile_grid(std::size_t i) const {
       return *cache_.front().grid;
     }
   }
+  Grid g = load_tile(i);
+  ++loads_;
+  return cache_insert(i, std::move(g));
+}
+
+bool Mosaic::cached(std::size_t i) const {
+  return std::any_of(cache_.begin(), cache_.end(), [&](const Cached& c) { return c.tile == i; });
+}
+
+Grid Mosaic::load_tile(std::size_t i) const {
   const MosaicTile& t = tiles_.at(i);
   Grid g = read_geographic(t.path, options_);
-  ++loads_;
   if (g.rows != t.rows || g.cols != t.cols || std::abs(g.georef.x0 - t.georef.x0) > 0.01 * t.georef.dx ||
       std::abs(g.georef.y0 - t.georef.y0) > 0.01 * t.georef.dy) {
     throw FormatError(t.path.string(), "content (" + std::to_string(g.rows) + " x " + std::to_string(g.cols) +
                                            " samples from " + fmt_deg(g.georef.y0) + ", " + fmt_deg(g.georef.x0) +
                                            ") does not match the extent its name gives");
   }
-  return cache_insert(i, std::move(g));
+  return g;
 }
 
 Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
@@ -231,39 +244,90 @@ Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
   out.georef.y0 = georef_.y0 - row0 * georef_.dy;
   out.allocate(n_rows, n_cols);
   std::fill(out.mask.begin(), out.mask.end(), Sample::kOutside);
-  for (std::size_t i = 0; i < tiles_.size(); ++i) {
-    const MosaicTile& t = tiles_[i];
-    const int r_begin = std::max(row0, t.row0), r_end = std::min(row0 + n_rows, t.row0 + t.rows);
-    const int c_begin = std::max(col0, t.col0), c_end = std::min(col0 + n_cols, t.col0 + t.cols);
-    if (r_begin >= r_end || c_begin >= c_end) continue;
-    // Skip the tile when earlier tiles already provided every sample it would give.
-    bool needed = false;
-    for (int r = r_begin; r < r_end && !needed; ++r) {
-      const std::size_t base = out.index(r - row0, 0);
-      for (int c = c_begin; c < c_end; ++c) {
-        if (out.mask[base + static_cast<std::size_t>(c - col0)] == Sample::kOutside) {
-          needed = true;
-          break;
+  // The tiles the window overlaps, in order, and those sure to be needed: giving some sample
+  // no earlier tile's extent holds (a projected tile may leave part of its extent outside, so
+  // the copy below still asks each tile's samples, as it always did).
+  struct Part {
+    std::size_t tile;
+    int r_begin, r_end, c_begin, c_end;
+    bool sure;
+  };
+  std::vector<Part> parts;
+  {
+    std::vector<std::uint8_t> held(static_cast<std::size_t>(n_rows) * static_cast<std::size_t>(n_cols), 0);
+    for (std::size_t i = 0; i < tiles_.size(); ++i) {
+      const MosaicTile& t = tiles_[i];
+      Part p{i, std::max(row0, t.row0), std::min(row0 + n_rows, t.row0 + t.rows), std::max(col0, t.col0),
+             std::min(col0 + n_cols, t.col0 + t.cols), false};
+      if (p.r_begin >= p.r_end || p.c_begin >= p.c_end) continue;
+      for (int r = p.r_begin; r < p.r_end; ++r) {
+        std::uint8_t* row = held.data() + out.index(r - row0, 0);
+        for (int c = p.c_begin; c < p.c_end; ++c) {
+          p.sure = p.sure || row[c - col0] == 0;
+          row[c - col0] = 1;
         }
       }
+      parts.push_back(p);
     }
-    if (!needed) continue;
-    const Grid& g = tile_grid(i);
-    if (out.format.empty()) {
-      out.format = g.format;
-      out.vertical_datum = g.vertical_datum;
-    } else {
-      if (out.format != g.format) out.format = "mixed";
-      if (out.vertical_datum != g.vertical_datum) out.vertical_datum = "mixed";
-    }
-    out.checksum_errors += g.checksum_errors;
-    for (int r = r_begin; r < r_end; ++r) {
-      for (int c = c_begin; c < c_end; ++c) {
-        const std::size_t o = out.index(r - row0, c - col0);
-        if (out.mask[o] != Sample::kOutside) continue;  // a shared edge already read
-        const std::size_t s = g.index(r - t.row0, c - t.col0);
-        out.heights[o] = g.heights[s];
-        out.mask[o] = g.mask[s];
+  }
+  // A cache's worth at a time: the sure tiles not cached decoded in parallel, then every tile
+  // copied in order, so that a shared edge comes from the first tile that has it. A bzip2 or
+  // zip tile decodes on one core: on the rf bench's Salt Lake City window (two .sdf.bz2
+  // tiles), 7 alternating runs on two free cores read the DEM in a median 0.30 s against
+  // 0.50 s one tile after the other, with the same CPU time. (An earlier attempt measured a
+  // loss, 3.09 s against 2.37 s of wall time, with the second core busy with other work.)
+  const std::size_t batch = std::max<std::size_t>(1, cache_capacity_);
+  for (std::size_t b0 = 0; b0 < parts.size(); b0 += batch) {
+    const std::size_t b1 = std::min(parts.size(), b0 + batch);
+    std::vector<std::optional<Grid>> fresh(b1 - b0);
+    std::vector<std::size_t> todo;
+    for (std::size_t k = b0; k < b1; ++k)
+      if (parts[k].sure && !cached(parts[k].tile)) todo.push_back(k);
+    // A tile that fails is reported as the serial read would: the first in tile order.
+    std::vector<std::exception_ptr> failed(todo.size());
+    tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t q) {
+      try {
+        fresh[todo[q] - b0] = load_tile(parts[todo[q]].tile);
+      } catch (...) {
+        failed[q] = std::current_exception();
+      }
+    });
+    for (const std::exception_ptr& e : failed)
+      if (e) std::rethrow_exception(e);
+    for (std::size_t k = b0; k < b1; ++k) {
+      const Part& p = parts[k];
+      const MosaicTile& t = tiles_[p.tile];
+      // Skip the tile when earlier tiles already provided every sample it would give.
+      bool needed = false;
+      for (int r = p.r_begin; r < p.r_end && !needed; ++r) {
+        const std::size_t base = out.index(r - row0, 0);
+        for (int c = p.c_begin; c < p.c_end; ++c) {
+          if (out.mask[base + static_cast<std::size_t>(c - col0)] == Sample::kOutside) {
+            needed = true;
+            break;
+          }
+        }
+      }
+      if (!needed) continue;
+      std::optional<Grid>& f = fresh[k - b0];
+      if (f) ++loads_;
+      const Grid& g = f ? cache_insert(p.tile, std::move(*f)) : tile_grid(p.tile);
+      if (out.format.empty()) {
+        out.format = g.format;
+        out.vertical_datum = g.vertical_datum;
+      } else {
+        if (out.format != g.format) out.format = "mixed";
+        if (out.vertical_datum != g.vertical_datum) out.vertical_datum = "mixed";
+      }
+      out.checksum_errors += g.checksum_errors;
+      for (int r = p.r_begin; r < p.r_end; ++r) {
+        for (int c = p.c_begin; c < p.c_end; ++c) {
+          const std::size_t o = out.index(r - row0, c - col0);
+          if (out.mask[o] != Sample::kOutside) continue;  // a shared edge already read
+          const std::size_t s = g.index(r - t.row0, c - t.col0);
+          out.heights[o] = g.heights[s];
+          out.mask[o] = g.mask[s];
+        }
       }
     }
   }

@@ -40,7 +40,8 @@ struct MosaicGap {
 // .hgt.zip records (compressed.h, recorded_size), without reading it; other tiles (.hgt.bz2:
 // bzip2 records no size) are read once at open() to learn their extent and kept in the cache. Decoded tiles live in a cache of at most
 // `cache_tiles` tiles, so memory is bounded by the window and the cache, not by the number
-// of input files. Not thread-safe (the cache is shared).
+// of input files. Not thread-safe (the cache is shared); read_window decodes the tiles it
+// needs in parallel itself.
 class Mosaic {
  public:
   // inputs: files and directories (a directory contributes every file in it whose name has a
@@ -82,6 +83,9 @@ class Mosaic {
   mutable std::list<Cached> cache_;  // most recently used first
   mutable std::size_t loads_ = 0;
   const Grid& cache_insert(std::size_t tile, Grid grid) const;
+  bool cached(std::size_t tile) const;
+  // Tile i read and checked against the extent its name gave (no cache: safe on any thread).
+  Grid load_tile(std::size_t i) const;
 };
 
 // Loads one DEM file as a geographic grid (read_dem, then to_geographic when projected).
