@@ -1582,10 +1582,14 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
     slot.key = *key;
     if (*key >= kOutsideKey0) kept_places.insert(*key);
     if (slot.store) {
+      // Sample (i, j) becomes (i - di, j - dj): its index moves by a constant (a kept slot's
+      // samples all lie in the overlap). Dividing each reference into (i, j) instead cost the
+      // bench's Utah slide (92,000 slots) 4-5 ms more: 96.5 and 79.4 ms against 91.6 and
+      // 75.3 ms, alternating runs.
+      const std::uint32_t lattice = lattice_count();
+      const auto moved_by = static_cast<std::uint32_t>(dj * (n + 1) + di);  // modulo 2^32: negative too
       for (std::uint32_t& r : slot.store->refs) {
-        if (r >= lattice_count()) continue;
-        const int i = static_cast<int>(r % static_cast<std::uint32_t>(n + 1)), j = static_cast<int>(r / static_cast<std::uint32_t>(n + 1));
-        r = vertex(i - di, j - dj);
+        if (r < lattice) r -= moved_by;
       }
     }
     moved.push_back(std::move(slot));
