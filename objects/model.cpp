@@ -227,6 +227,19 @@ struct Collector {
   const aiScene* scene;
   const std::string& source;
   Model& model;
+  // Each material's texture and its coordinate set, decoded once for every mesh (and every
+  // node placing a mesh) that uses the material.
+  struct MaterialTexture {
+    std::optional<Texture> texture;
+    unsigned channel = 0;
+  };
+  std::unordered_map<unsigned, MaterialTexture> textures;
+
+  const MaterialTexture& texture_of(unsigned index, const aiMaterial& material) {
+    const auto [it, fresh] = textures.try_emplace(index);
+    if (fresh) it->second.texture = material_texture(*scene, material, model.file, source, it->second.channel, model.missing_textures);
+    return it->second;
+  }
 
   void node(const aiNode* n, const aiMatrix4x4& parent) {
     const aiMatrix4x4 m = parent * n->mTransformation;
@@ -240,12 +253,11 @@ struct Collector {
     const aiMaterial* material = a->mMaterialIndex < scene->mNumMaterials ? scene->mMaterials[a->mMaterialIndex] : nullptr;
     const bool per_vertex = a->HasVertexColors(0);
     model.vertex_colors = model.vertex_colors || per_vertex;
-    unsigned channel = 0;
-    std::optional<Texture> texture;
-    if (material != nullptr) texture = material_texture(*scene, *material, model.file, source, channel, model.missing_textures);
-    if (texture && !a->HasTextureCoords(channel)) texture.reset();
-    if (texture) ++model.textured_meshes;
-    const aiColor4D mc = material_color(material, texture.has_value());
+    const MaterialTexture* mt = material != nullptr ? &texture_of(a->mMaterialIndex, *material) : nullptr;
+    const Texture* texture = mt != nullptr && mt->texture && a->HasTextureCoords(mt->channel) ? &*mt->texture : nullptr;
+    const unsigned channel = texture != nullptr ? mt->channel : 0;
+    if (texture != nullptr) ++model.textured_meshes;
+    const aiColor4D mc = material_color(material, texture != nullptr);
     std::size_t faces = 0;
     for (unsigned f = 0; f < a->mNumFaces; ++f) faces += a->mFaces[f].mNumIndices == 3 ? 1 : 0;
     if (faces == 0) return;
@@ -342,7 +354,7 @@ Model read_model(const std::filesystem::path& file) {
   }
   Model model;
   model.file = file;
-  Collector{scene, source, model}.node(scene->mRootNode, aiMatrix4x4());
+  Collector{scene, source, model, {}}.node(scene->mRootNode, aiMatrix4x4());
   if (model.mesh.empty()) throw io::FormatError(source, "no triangles in the model");
   return model;
 }
