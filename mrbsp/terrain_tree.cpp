@@ -500,7 +500,7 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     glm::vec3 content_lo() const { return glm::vec3(lo.x, lo.y, bottom); }
     glm::vec3 content_hi() const { return glm::vec3(hi.x, hi.y, top); }
   };
-  const auto box_of = [&](int level, int ci, int cj, const CellZ& cz) {
+  const auto box_of = [&](int level, int ci, int cj, const CellZ& cz) __attribute__((always_inline)) {
     const int s = m.cell_size(level), i0 = ci * s, j0 = cj * s;
     const bool wall = (beyond[0] && i0 == 0) || (beyond[1] && i0 + s == m.n) || (beyond[2] && j0 == 0) || (beyond[3] && j0 + s == m.n);
     return Box{glm::vec3(static_cast<float>(m.xs[static_cast<std::size_t>(i0)]), static_cast<float>(m.ys[static_cast<std::size_t>(j0)]), cz.zmin),
@@ -524,6 +524,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // (bits 52-56).
   const auto decide = [&](std::uint64_t item, std::vector<std::uint64_t>& st, std::vector<std::vector<std::uint64_t>>& lists) {
     const int level = level_index_of(item) - m.top, ci = ci_of(item), cj = cj_of(item);
+    if (level == m.levels - 1 && (item >> 52 & 31) == 0) {
+      // A finest cell inside every frustum plane its parent straddled is drawn whatever its
+      // box: its heights (four samples of the lattice, a cache miss or two) are not read.
+      marks[m.cell_id(level, ci, cj)] = stamp | kDrawn;
+      lists[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
+      return;
+    }
     const CellZ cz = m.cell_z(level, ci, cj);
     const Box box = box_of(level, ci, cj, cz);
     const int planes_left = options.cull ? box_planes(planes, box.content_lo(), box.content_hi(), static_cast<int>(item >> 52) & 31) : 0;
@@ -541,6 +548,21 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     if (!refine) {
       lists[static_cast<std::size_t>(level)].push_back(static_cast<std::uint64_t>(ci) << 32 | static_cast<std::uint32_t>(cj));
       return;
+    }
+    // The children's heights and marks, asked for now: they are decided after the deepest
+    // child's subtree, and on a cold cache (a frame's draw comes between traversals) each is
+    // a miss otherwise. Two rows of each.
+    const int child = level + 1;
+    for (int row = 0; row < 2; ++row) {
+      const int cj2 = 2 * cj + row;
+      if (child >= 0) __builtin_prefetch(&marks[m.cell_id(child, 2 * ci, cj2)], 1);
+      if (child < m.levels - 1) {
+        __builtin_prefetch(&m.cellz[m.cellz_offset[static_cast<std::size_t>(child + m.top)] +
+                                    static_cast<std::size_t>(cj2 * m.cells_at(child) + 2 * ci)]);
+      } else if (planes_left != 0) {
+        __builtin_prefetch(&m.positions[m.vertex(2 * ci, cj2)]);
+        if (row == 1) __builtin_prefetch(&m.positions[m.vertex(2 * ci, cj2 + 1)]);
+      }
     }
     for (int k = 0; k < 4; ++k) {
       st.push_back(pack(kSquare, level_index_of(item) + 1, 2 * ci + (k & 1), 2 * cj + (k >> 1)) |
@@ -766,6 +788,10 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       const bool above_last = above != 0 && !above_first;
       if (above_last) stack.push_back(above);
       if (refine) {
+        if (level + 1 >= 0) {  // the children's marks, read when they come off the stack
+          __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj)]);
+          __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj + 1)]);
+        }
         const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
         if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
       } else {

@@ -86,7 +86,7 @@ struct TraversalOptions {
   // The last pass (the drawn cells and small BSPs written out as triangles) runs in parallel
   // chunks of the draw order, joined in that order, when the frame is estimated to draw at
   // least this many triangles and has no colour boxes; the triangles are the same either way.
-  std::size_t parallel_min_triangles = 32768;
+  std::size_t parallel_min_triangles = 8192;
   // The LOD choice decides the subtrees below LOD level 1 in parallel when the previous
   // traversal into the same Frame visited at least this many cells (a Frame's first is
   // serial); the choice is the same either way.
