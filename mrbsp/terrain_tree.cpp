@@ -416,8 +416,9 @@ double box_area_px(const Camera& c, const glm::dvec3& f, const glm::dvec3& r, co
 }
 
 // Traversal stack items: an implicit node name or a slot to emit, packed into 64 bits.
-// Bits 0-2 kind, 3-8 level + top, 9-29 ci, 30-50 cj, 51 half (which x half); slots: bits 3+.
-enum : std::uint64_t { kSquare = 0, kHalf = 1, kEmitSlot = 2, kLeaf = 3, kEmitBoxes = 4 };
+// Bits 0-2 kind, 3-8 level + top, 9-29 ci, 30-50 cj, 51 half (which x half); slots, and the
+// places of subtrees walked apart (pass 4), bits 3+.
+enum : std::uint64_t { kSquare = 0, kHalf = 1, kEmitSlot = 2, kLeaf = 3, kEmitBoxes = 4, kSubtreePlace = 5 };
 constexpr std::uint64_t pack(std::uint64_t kind, int level_index, int ci, int cj, int half = 0) {
   return kind | (static_cast<std::uint64_t>(level_index) << 3) | (static_cast<std::uint64_t>(ci) << 9) |
          (static_cast<std::uint64_t>(cj) << 30) | (static_cast<std::uint64_t>(half) << 51);
@@ -670,17 +671,88 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
   }
 
+  // One item of the walk below: what it puts out, and what it pushes onto `items` (the
+  // walk's stack, or one subtree's) to come out after it.
+  const auto walk_item = [&](bool b2f, std::uint64_t item, std::vector<std::uint64_t>& items, auto&& enter, auto&& out) {
+    const auto push_pair = [&](std::uint64_t far_item, std::uint64_t near_item) {
+      items.push_back(b2f ? near_item : far_item);
+      items.push_back(b2f ? far_item : near_item);
+    };
+    const std::uint64_t kind = kind_of(item);
+    if (kind == kEmitSlot || kind == kLeaf || kind == kEmitBoxes) {
+      out(item);
+      return;
+    }
+    const int level_index = level_index_of(item), level = level_index - m.top;
+    const int ci = ci_of(item), cj = cj_of(item);
+    const int s = m.cell_size(level), half = s / 2;
+    const int i0 = ci * s, j0 = cj * s;
+    if (kind == kHalf) {  // the y split of one x half of a square
+      const int a = half_of(item);
+      if (level >= 0 && !enter(level, ci, cj, a)) return;  // hidden
+      const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
+      const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
+      if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
+      return;
+    }
+    // A square: a top cell (always split, if in view) or an LOD cell as decided.
+    bool refine = true;
+    // A cell left out keeps the colour boxes of its whole column, drawn in its place.
+    const auto left_out = [&] {
+      const std::int32_t b = box_order ? box_order->whole(level_index, ci, cj) : -1;
+      if (b >= 0) out(pack_boxes(b));
+    };
+    if (level >= 0) {
+      const std::uint32_t st = state(m.cell_id(level, ci, cj));
+      if (st == 0 || !enter(level, ci, cj, -1)) {  // out of view, or hidden
+        left_out();
+        return;
+      }
+      refine = st == kRefined;
+    } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
+      left_out();
+      return;
+    }
+    const CellContent* content = content_of(level, ci, cj);
+    // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
+    // eye is below the plane z = zmax they are far), the terrain part, the pieces above
+    // (when the eye is above that plane they are near). Pushed in reverse. Colour boxes above
+    // the cell go into its above slot when it has one, else they come out in its place, at
+    // their separation height (mrbsp/box_order.h).
+    std::uint64_t above = 0;
+    double above_z = 0.0;
+    if (content && content->above >= 0) {
+      above = pack_slot(content->above);
+      above_z = static_cast<double>(m.cell_z(level, ci, cj).zmax);
+    } else if (const std::int32_t b = box_order ? box_order->above(level_index, ci, cj) : -1; b >= 0) {
+      above = pack_boxes(b);
+      above_z = static_cast<double>(separation_height(m, level, ci, cj));
+    }
+    const bool above_near = above != 0 && e.z >= above_z;
+    const bool above_first = above != 0 && above_near != b2f;
+    const bool above_last = above != 0 && !above_first;
+    if (above_last) items.push_back(above);
+    if (refine) {
+      if (level + 1 >= 0) {  // the children's marks, read when they come off the stack
+        __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj)]);
+        __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj + 1)]);
+      }
+      const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
+      if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
+    } else {
+      items.push_back(pack(kLeaf, level_index, ci, cj));
+    }
+    if (above_first) items.push_back(above);
+  };
   // The decided tree in order (the far side of every split first for back_to_front, the near
   // one otherwise): `enter(level, ci, cj, half)` for each LOD cell reached (half -1) and each
   // of its x halves (half 0 west, 1 east) when it is refined (false leaves it out),
   // `out(item)` for each drawn cell (kLeaf) and slot (kEmitSlot) in order. Items on the stack
-  // are pushed in reverse of the order they are to come out in.
-  const auto walk = [&](bool b2f, auto&& enter, auto&& out) {
+  // are pushed in reverse of the order they are to come out in. A square at level index
+  // `split_at` (none: -1) is handed to `at_split` in its place instead, for its subtree to be
+  // walked apart (walk_item from it alone gives that subtree's part of the order).
+  const auto walk = [&](bool b2f, auto&& enter, auto&& out, int split_at, auto&& at_split) {
     stack.clear();
-    const auto push_pair = [&](std::uint64_t far_item, std::uint64_t near_item) {
-      stack.push_back(b2f ? near_item : far_item);
-      stack.push_back(b2f ? far_item : near_item);
-    };
     // The window, inside the chain of its four boundary planes: beyond each lie the kOutside
     // slots of one side (west x < xs[0], east x > xs[n], south y < ys[0], north y > ys[n]), in
     // bands parallel to the plane. Built from the innermost out: the window, then each
@@ -733,71 +805,11 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     while (!stack.empty()) {
       const std::uint64_t item = stack.back();
       stack.pop_back();
-      const std::uint64_t kind = kind_of(item);
-      if (kind == kEmitSlot || kind == kLeaf || kind == kEmitBoxes) {
-        out(item);
+      if (kind_of(item) == kSquare && level_index_of(item) == split_at) {
+        at_split(item);
         continue;
       }
-      const int level_index = level_index_of(item), level = level_index - m.top;
-      const int ci = ci_of(item), cj = cj_of(item);
-      const int s = m.cell_size(level), half = s / 2;
-      const int i0 = ci * s, j0 = cj * s;
-      if (kind == kHalf) {  // the y split of one x half of a square
-        const int a = half_of(item);
-        if (level >= 0 && !enter(level, ci, cj, a)) continue;  // hidden
-        const std::uint64_t south = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj);
-        const std::uint64_t north = pack(kSquare, level_index + 1, 2 * ci + a, 2 * cj + 1);
-        if (e.y >= m.ys[static_cast<std::size_t>(j0 + half)]) push_pair(south, north); else push_pair(north, south);
-        continue;
-      }
-      // A square: a top cell (always split, if in view) or an LOD cell as decided.
-      bool refine = true;
-      // A cell left out keeps the colour boxes of its whole column, drawn in its place.
-      const auto left_out = [&] {
-        const std::int32_t b = box_order ? box_order->whole(level_index, ci, cj) : -1;
-        if (b >= 0) out(pack_boxes(b));
-      };
-      if (level >= 0) {
-        const std::uint32_t st = state(m.cell_id(level, ci, cj));
-        if (st == 0 || !enter(level, ci, cj, -1)) {  // out of view, or hidden
-          left_out();
-          continue;
-        }
-        refine = st == kRefined;
-      } else if (!in_view(box_of(level, ci, cj, m.cell_z(level, ci, cj)))) {
-        left_out();
-        continue;
-      }
-      const CellContent* content = content_of(level, ci, cj);
-      // What comes out, in back-to-front order: the pieces above the cell's terrain (when the
-      // eye is below the plane z = zmax they are far), the terrain part, the pieces above
-      // (when the eye is above that plane they are near). Pushed in reverse. Colour boxes above
-      // the cell go into its above slot when it has one, else they come out in its place, at
-      // their separation height (mrbsp/box_order.h).
-      std::uint64_t above = 0;
-      double above_z = 0.0;
-      if (content && content->above >= 0) {
-        above = pack_slot(content->above);
-        above_z = static_cast<double>(m.cell_z(level, ci, cj).zmax);
-      } else if (const std::int32_t b = box_order ? box_order->above(level_index, ci, cj) : -1; b >= 0) {
-        above = pack_boxes(b);
-        above_z = static_cast<double>(separation_height(m, level, ci, cj));
-      }
-      const bool above_near = above != 0 && e.z >= above_z;
-      const bool above_first = above != 0 && above_near != b2f;
-      const bool above_last = above != 0 && !above_first;
-      if (above_last) stack.push_back(above);
-      if (refine) {
-        if (level + 1 >= 0) {  // the children's marks, read when they come off the stack
-          __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj)]);
-          __builtin_prefetch(&marks[m.cell_id(level + 1, 2 * ci, 2 * cj + 1)]);
-        }
-        const std::uint64_t west = pack(kHalf, level_index, ci, cj, 0), east = pack(kHalf, level_index, ci, cj, 1);
-        if (e.x >= m.xs[static_cast<std::size_t>(i0 + half)]) push_pair(west, east); else push_pair(east, west);
-      } else {
-        stack.push_back(pack(kLeaf, level_index, ci, cj));
-      }
-      if (above_first) stack.push_back(above);
+      walk_item(b2f, item, stack, enter, out);
     }
   };
   // A drawn cell's crack fills: where the same-level neighbour is refined, balance put it one
@@ -1010,7 +1022,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
           const Projected* ends[4][2] = {{&nw, &sw}, {&se, &ne}, {&sw, &se}, {&ne, &nw}};
           for (std::size_t k = 0; k < 4; ++k)
             if (edges[k].needed) tile(*ends[k][0], project_vertex(edges[k].mid), *ends[k][1]);
-        });
+        },
+        -1, [](std::uint64_t) {});
     frame.occlusion.pass_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 
@@ -1038,25 +1051,78 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     box_order = frame.box_scratch_.get();
   }
 
-  // Pass 4, the order of the draw: the decided tree, less what occlusion found hidden.
+  // Pass 4, the order of the draw: the decided tree, less what occlusion found hidden. When
+  // the LOD choice ran in parallel subtrees, and no colour boxes share their scratch, so does
+  // the walk: each subtree below LOD level 1 into its own part of the order, joined in order.
+  // The low slots drawn for the first time are built after the walk, in the draw's order
+  // (each is built once, before pass 5 emits it, as when they were built on the way).
   auto& leaves = frame.leaves_;
   leaves.clear();
-  walk(
-      back_to_front,
-      [&](int level, int ci, int cj, int half) {
-        const std::uint32_t cell = m.cell_id(level, ci, cj);
-        if (occlusion && half < 0 && frame.visibility_[cell] == (frame.current_stamp_ << 2 | kWasHidden)) return false;
-        if (half < 0 && state(cell) == kDrawn) {
-          const CellContent* content = content_of(level, ci, cj);
-          if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) {
-            lazy.build_pending(static_cast<std::size_t>(content->low));
-          }
-          ++frame.lod_histogram[static_cast<std::size_t>(level)];
-          ++frame.leaves;
+  // What one part of the walk enters: its drawn cells counted per level and in all, the
+  // unbuilt low slots among them listed.
+  const auto enter_into = [&](std::vector<std::size_t>& histogram, std::size_t& drawn, std::vector<std::int32_t>& unbuilt) {
+    return [&, h = &histogram, d = &drawn, u = &unbuilt](int level, int ci, int cj, int half) {
+      const std::uint32_t cell = m.cell_id(level, ci, cj);
+      if (occlusion && half < 0 && frame.visibility_[cell] == (frame.current_stamp_ << 2 | kWasHidden)) return false;
+      if (half < 0 && state(cell) == kDrawn) {
+        const CellContent* content = content_of(level, ci, cj);
+        if (content && content->low >= 0 && !m.slots[static_cast<std::size_t>(content->low)].built) u->push_back(content->low);
+        ++(*h)[static_cast<std::size_t>(level)];
+        ++*d;
+      }
+      return true;
+    };
+  };
+  auto& walk_roots = frame.subtree_roots_;  // pass 1 is done with its own
+  walk_roots.clear();
+  auto& unbuilt = frame.unbuilt_;  // the serial part's, with -1 - k in subtree k's place
+  unbuilt.clear();
+  walk(back_to_front, enter_into(frame.lod_histogram, frame.leaves, unbuilt), [&](std::uint64_t item) { leaves.push_back(item); },
+       box_order == nullptr ? split : -1, [&](std::uint64_t root) {
+         leaves.push_back(kSubtreePlace | static_cast<std::uint64_t>(walk_roots.size()) << 3);
+         unbuilt.push_back(-1 - static_cast<std::int32_t>(walk_roots.size()));
+         walk_roots.push_back(root);
+       });
+  if (!walk_roots.empty()) {
+    if (frame.subtrees_.size() < walk_roots.size()) frame.subtrees_.resize(walk_roots.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, walk_roots.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t k = range.begin(); k != range.end(); ++k) {
+        Frame::Subtree& sub = frame.subtrees_[k];
+        sub.leaves.clear();
+        sub.unbuilt.clear();
+        sub.histogram.assign(static_cast<std::size_t>(m.levels), 0);
+        sub.nodes = 0;  // here: its drawn cells
+        const auto enter = enter_into(sub.histogram, sub.nodes, sub.unbuilt);
+        const auto out = [&](std::uint64_t item) { sub.leaves.push_back(item); };
+        sub.stack.assign(1, walk_roots[k]);
+        while (!sub.stack.empty()) {
+          const std::uint64_t item = sub.stack.back();
+          sub.stack.pop_back();
+          walk_item(back_to_front, item, sub.stack, enter, out);
         }
-        return true;
-      },
-      [&](std::uint64_t item) { leaves.push_back(item); });
+      }
+    });
+    auto& joined = frame.joined_leaves_;
+    joined.clear();
+    for (const std::uint64_t item : leaves) {
+      if (kind_of(item) != kSubtreePlace) {
+        joined.push_back(item);
+        continue;
+      }
+      const Frame::Subtree& sub = frame.subtrees_[static_cast<std::size_t>(item >> 3)];
+      joined.insert(joined.end(), sub.leaves.begin(), sub.leaves.end());
+      frame.leaves += sub.nodes;
+      for (std::size_t l = 0; l < sub.histogram.size(); ++l) frame.lod_histogram[l] += sub.histogram[l];
+    }
+    leaves.swap(joined);
+  }
+  for (const std::int32_t slot : unbuilt) {
+    if (slot >= 0) {
+      lazy.build_pending(static_cast<std::size_t>(slot));
+      continue;
+    }
+    for (const std::int32_t s : frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt) lazy.build_pending(static_cast<std::size_t>(s));
+  }
   if (occlusion) {
     std::size_t drawn = 0;  // the drawn cells of the LOD choice, culled or not
     for (int level = 0; level < m.levels; ++level)

@@ -196,15 +196,22 @@ struct Frame {
   std::vector<EmitChunk> chunks_;
   std::vector<std::size_t> chunk_cuts_;  // chunk c: leaves_[chunk_cuts_[c], chunk_cuts_[c + 1])
   std::vector<std::vector<std::uint64_t>> by_level_;  // drawn cells per level (ci << 32 | cj)
-  // The LOD choice's subtrees decided in parallel: their roots, and each one's stack, drawn
-  // cells per level and cells visited.
+  // The subtrees the LOD choice decides, and the walk of the draw order walks, in parallel:
+  // their roots, and each one's stack, drawn cells per level and cells visited (the walk's:
+  // cells drawn), and the walk's part of the order, drawn cells counted per level and low
+  // slots to build.
   std::vector<std::uint64_t> subtree_roots_;
   struct Subtree {
     std::vector<std::uint64_t> stack;
     std::vector<std::vector<std::uint64_t>> by_level;
     std::size_t nodes = 0;
+    std::vector<std::uint64_t> leaves;
+    std::vector<std::size_t> histogram;
+    std::vector<std::int32_t> unbuilt;
   };
   std::vector<Subtree> subtrees_;
+  std::vector<std::int32_t> unbuilt_;        // the walk's low slots to build (-1 - k: subtree k's)
+  std::vector<std::uint64_t> joined_leaves_;  // the walk's order with the subtrees' parts in place
   std::unique_ptr<coverage::Pyramid> pyramid_;        // the occlusion pass's
   std::vector<std::uint32_t> visibility_;  // per cell: stamp << 2 | what occlusion found
   std::vector<std::uint32_t> stamp_;  // per cell: the traversal that last drew it

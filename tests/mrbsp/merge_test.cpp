@@ -239,6 +239,44 @@ TEST(Merge, AnLodChoiceDecidedInParallelSubtreesDrawsTheSerialFrame) {
   EXPECT_GT(split_frames, 16u) << "and the split, where some level-0 cell in view is refined";
 }
 
+// The walk of the draw order in parallel subtrees builds the low alternatives it draws for
+// the first time after the walk: in the serial walk's order, so that their vertices get the
+// same indices. Two trees made alike, one traversed serially and one split, from the same
+// seeded cameras: the same triangles, vertex for vertex, and the same slots built.
+TEST(Merge, AWalkInParallelSubtreesBuildsNewLowSlotsInTheSerialOrder) {
+  std::mt19937 rng_serial(31), rng_split(31);
+  TestWindow w_serial(64, [](int, int) { return 0.0f; }), w_split(64, [](int, int) { return 0.0f; });
+  TerrainTree serial_tree = hilly_tree(rng_serial, w_serial), split_tree = hilly_tree(rng_split, w_split);
+  const Soup soup = random_triangles(rng_serial, 600, {-100.0, 6500.0, -50.0, 300.0, 60.0});
+  serial_tree.merge(soup.v, soup.c, soup.t);
+  split_tree.merge(soup.v, soup.c, soup.t);
+  ASSERT_GT(serial_tree.merge_stats().pending_slots, 0u) << "low alternatives must wait to be built";
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 1500.0), dir(-1.0, 1.0);
+  Frame serial, split;
+  std::size_t split_frames = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.7 + 0.3 * dir(rng)});
+    TraversalOptions o;
+    o.cull = trial % 4 != 0;
+    o.threshold_px = 0.5f + static_cast<float>(trial % 3);
+    o.parallel_min_nodes = std::numeric_limits<std::size_t>::max();
+    serial_tree.traverse(c, o, serial);
+    o.parallel_min_nodes = 0;
+    split_tree.traverse(c, o, split);
+    split_frames += split.subtree_roots_.empty() ? 0 : 1;
+    ASSERT_EQ(split.indices, serial.indices) << "trial " << trial;
+    EXPECT_EQ(split.level, serial.level) << "trial " << trial;
+    EXPECT_EQ(split.leaves, serial.leaves) << "trial " << trial;
+    EXPECT_EQ(split.lod_histogram, serial.lod_histogram) << "trial " << trial;
+    EXPECT_EQ(split_tree.merge_stats().lazy_built_slots, serial_tree.merge_stats().lazy_built_slots) << "trial " << trial;
+    EXPECT_EQ(split_tree.positions().size(), serial_tree.positions().size()) << "trial " << trial;
+  }
+  EXPECT_GT(split_frames, 10u) << "the walk must be split";
+  EXPECT_GT(split_tree.merge_stats().lazy_built_slots, 2u) << "and slots built by the split walks";
+}
+
 // Culling by content boxes: from cameras inside and beside the merged triangles, low over the
 // ground and looking up, down and level, the merged area drawn inside the view frustum is the
 // input's visible area inside it (the reference clips the inputs to the frustum, derived by
