@@ -1468,24 +1468,37 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
 }
 
 void TerrainTree::Impl::build_pending(std::size_t k) {
-  Slot& slot = slots[k];
+  const auto slot = static_cast<std::int32_t>(k);
+  build_pending(std::span<const std::int32_t>(&slot, 1));
+}
+
+void TerrainTree::Impl::build_pending(std::span<const std::int32_t> ks) {
+  if (ks.empty()) return;
   const auto t0 = Clock::now();
-  slot.store = std::make_unique<BspStore>();
-  SlotBuilder builder(*this, *slot.store);
-  for (const auto& [id, s] : surfaces) {
-    s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
+  // Each slot's builder reads the surfaces and the lattice and writes its own store, its
+  // vertices staged; the flushes, which append to positions, come after all of them.
+  tbb::parallel_for(std::size_t{0}, ks.size(), [&](std::size_t q) {
+    Slot& slot = slots[static_cast<std::size_t>(ks[q])];
+    slot.store = std::make_unique<BspStore>();
+    SlotBuilder builder(*this, *slot.store);
+    for (const auto& [id, s] : surfaces) {
+      s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
+    }
+    const CellName c = cell_name(*this, slot.key / 2);
+    builder.build_low(c.level, c.ci, c.cj);
+    slot.built = true;
+    slot.pending = 0;
+    slot.store->bound_nodes(positions);  // read only here: flushes come after
+  });
+  for (const std::int32_t k : ks) {
+    Slot& slot = slots[static_cast<std::size_t>(k)];
+    flush(*slot.store);
+    merge_stats.stored_polygons += slot.store->pieces;
+    merge_stats.dropped_pieces += slot.store->dropped;
+    --merge_stats.pending_slots;
+    ++merge_stats.lazy_built_slots;
   }
-  const CellName c = cell_name(*this, slot.key / 2);
-  builder.build_low(c.level, c.ci, c.cj);
-  slot.built = true;
-  slot.pending = 0;
-  flush(*slot.store);
-  slot.store->bound_nodes(positions);
-  merge_stats.stored_polygons += slot.store->pieces;
-  merge_stats.dropped_pieces += slot.store->dropped;
   merge_stats.merged_vertices = merged_colors.size();
-  --merge_stats.pending_slots;
-  ++merge_stats.lazy_built_slots;
   merge_stats.lazy_build_ms += ms_since(t0);
 }
 

@@ -1054,8 +1054,9 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // Pass 4, the order of the draw: the decided tree, less what occlusion found hidden. When
   // the LOD choice ran in parallel subtrees, and no colour boxes share their scratch, so does
   // the walk: each subtree below LOD level 1 into its own part of the order, joined in order.
-  // The low slots drawn for the first time are built after the walk, in the draw's order
-  // (each is built once, before pass 5 emits it, as when they were built on the way).
+  // The low slots drawn for the first time are built after the walk, in parallel, their
+  // vertices flushed in the draw's order (each is built once, before pass 5 emits it, and its
+  // vertices get the indices they got when slots were built one by one on the way).
   auto& leaves = frame.leaves_;
   leaves.clear();
   // What one part of the walk enters: its drawn cells counted per level and in all, the
@@ -1116,12 +1117,21 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
     leaves.swap(joined);
   }
+  bool any_unbuilt = false;
   for (const std::int32_t slot : unbuilt) {
-    if (slot >= 0) {
-      lazy.build_pending(static_cast<std::size_t>(slot));
-      continue;
+    any_unbuilt = any_unbuilt || slot >= 0 || !frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt.empty();
+  }
+  if (any_unbuilt) {  // rare: a region drawn at a level for the first time
+    std::vector<std::int32_t> in_order;
+    for (const std::int32_t slot : unbuilt) {
+      if (slot >= 0) {
+        in_order.push_back(slot);
+        continue;
+      }
+      const auto& part = frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt;
+      in_order.insert(in_order.end(), part.begin(), part.end());
     }
-    for (const std::int32_t s : frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt) lazy.build_pending(static_cast<std::size_t>(s));
+    lazy.build_pending(in_order);
   }
   if (occlusion) {
     std::size_t drawn = 0;  // the drawn cells of the LOD choice, culled or not

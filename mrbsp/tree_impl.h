@@ -315,6 +315,9 @@ struct TerrainTree::Impl {
   void redistribute_all();  // after refresh(): every surface again, every slot anew
   // Builds slots[k] (a low slot first drawn) and flushes its vertices.
   void build_pending(std::size_t k);
+  // Builds those slots (low slots first drawn, none built yet, no repeats) in parallel, then
+  // flushes their vertices in the order given: the indices one by one in that order gives.
+  void build_pending(std::span<const std::int32_t> ks);
   // Moves a store's staged vertices into positions and merged_colors.
   void flush(BspStore& store);
   void make_content();
