@@ -64,6 +64,19 @@ Soup random_soup(std::mt19937& rng, int count, bool in_planes = true) {
 // A camera at `eye` looking along `forward` (not vertical), 60 degrees wide.
 Camera camera_at(const glm::dvec3& eye, glm::dvec3 forward) { return test::looking(eye, forward, 60.0, 320, 200, 0.5); }
 
+// A seeded eye (x and y from `xy`, z from `z`) and a camera from it looking along a seeded
+// direction whose z component is pitch + spread * U(-1, 1).
+struct SeededView {
+  glm::dvec3 eye;
+  Camera camera;
+};
+SeededView seeded_view(std::mt19937& rng, std::uniform_real_distribution<double>& xy, std::uniform_real_distribution<double>& z,
+                       double pitch, double spread) {
+  std::uniform_real_distribution<double> dir(-1.0, 1.0);
+  const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
+  return {eye, camera_at(eye, {dir(rng), dir(rng), pitch + spread * dir(rng)})};
+}
+
 // The window's footprint: 16 cells of 100 m from the origin.
 constexpr double kX0 = 0.0, kX1 = 1600.0;
 
@@ -177,12 +190,11 @@ TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
   TerrainTree tree = hilly_tree(rng, w);
   Soup soup = random_triangles(rng, 600, {-100.0, 1700.0, -50.0, 500.0, 40.0});
   tree.merge(soup.v, soup.c, soup.t);
-  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(50.0, 900.0), dir(-1.0, 1.0);
+  std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(50.0, 900.0);
   Frame serial, chunked;
   std::size_t merged = 0;
   for (int trial = 0; trial < 24; ++trial) {
-    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
-    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.4 + 0.3 * dir(rng)});
+    const auto [eye, c] = seeded_view(rng, xy, z, -0.4, 0.3);
     TraversalOptions o;
     o.cull = trial % 2 == 0;
     o.front_to_back = trial % 3 == 2;
@@ -211,12 +223,11 @@ TEST(Merge, AnLodChoiceDecidedInParallelSubtreesDrawsTheSerialFrame) {
   TerrainTree tree = hilly_tree(rng, w);
   Soup soup = random_triangles(rng, 400, {-100.0, 6500.0, -50.0, 500.0, 60.0});
   tree.merge(soup.v, soup.c, soup.t);
-  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 2500.0), dir(-1.0, 1.0);
+  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 2500.0);
   Frame serial, split;
   std::size_t balanced = 0, split_frames = 0;
   for (int trial = 0; trial < 24; ++trial) {
-    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
-    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.6 + 0.4 * dir(rng)});
+    const auto [eye, c] = seeded_view(rng, xy, z, -0.6, 0.4);
     TraversalOptions o;
     o.cull = trial % 3 != 0;
     o.metric = trial % 4 == 3 ? LodMetric::kArea : LodMetric::kError;
@@ -252,12 +263,11 @@ TEST(Merge, AWalkInParallelSubtreesBuildsNewLowSlotsInTheSerialOrder) {
   split_tree.merge(soup.v, soup.c, soup.t);
   ASSERT_GT(serial_tree.merge_stats().pending_slots, 0u) << "low alternatives must wait to be built";
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 1500.0), dir(-1.0, 1.0);
+  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 1500.0);
   Frame serial, split;
   std::size_t split_frames = 0;
   for (int trial = 0; trial < 16; ++trial) {
-    const glm::dvec3 eye(xy(rng), xy(rng), z(rng));
-    const Camera c = camera_at(eye, {dir(rng), dir(rng), -0.7 + 0.3 * dir(rng)});
+    const auto [eye, c] = seeded_view(rng, xy, z, -0.7, 0.3);
     TraversalOptions o;
     o.cull = trial % 4 != 0;
     o.threshold_px = 0.5f + static_cast<float>(trial % 3);
