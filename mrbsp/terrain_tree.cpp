@@ -631,7 +631,8 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       auto& list = by_level[static_cast<std::size_t>(k)];
       for (std::size_t q = 0; q < list.size(); ++q) {
         const int ci = static_cast<int>(list[q] >> 32), cj = static_cast<int>(list[q] & 0xFFFFFFFFu);
-        if (state(m.cell_id(k, ci, cj)) != kDrawn) continue;
+        // A finest cell is never refined: only coarser ones need their state read again.
+        if (k < m.levels - 1 && state(m.cell_id(k, ci, cj)) != kDrawn) continue;
         const int pi = ci / 2, pj = cj / 2, pc = m.cells_at(k - 1);
         // Siblings ask the same of their parent's neighbours: once is enough (kChecked, a bit
         // beside the parent's state; a later refinement of the parent may clear it, which only
@@ -1332,8 +1333,13 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     const CellContent* content = content_of(level_index_of(item) - m.top, ci_of(item), cj_of(item));
     return content && content->low >= 0 ? m.slots[static_cast<std::size_t>(content->low)].store->pieces : 2;
   };
+  // Without merged content every item is a cell of two triangles (and its crack fills): the
+  // estimate and the cuts need no walk over the items.
+  const bool cells_only = m.slots.empty() && !box_order;
   std::size_t estimate = 0;
-  if (!box_order) {
+  if (cells_only) {
+    estimate = 2 * leaves.size();
+  } else if (!box_order) {
     for (const std::uint64_t item : leaves) estimate += estimate_of(item);
   }
   const std::size_t chunks = box_order || estimate < options.parallel_min_triangles
@@ -1345,6 +1351,10 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   cut.assign(chunks + 1, leaves.size());
   cut[0] = 0;
   std::size_t so_far = 0, next = 1;
+  if (cells_only) {
+    for (std::size_t c = 1; c < chunks; ++c) cut[c] = leaves.size() * c / chunks;
+    next = chunks;
+  }
   for (std::size_t k = 0; k < leaves.size() && next < chunks; ++k) {
     so_far += estimate_of(leaves[k]);
     while (next < chunks && so_far * chunks >= estimate * next) cut[next++] = k + 1;

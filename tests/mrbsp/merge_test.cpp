@@ -183,13 +183,17 @@ TEST(Merge, ALargeSurfaceSentInChunksDrawsItsWholeVisibleAreaInOrder) {
 // The last pass of a traversal writes large frames in parallel chunks of the draw order and
 // joins them: from random eyes, with and without culling, back to front and front to back,
 // the chunked frame keeps the brute-force ray order and is the serial one triangle for
-// triangle, with the same crack fills.
+// triangle, with the same crack fills; so is a chunked frame of a tree of terrain alone.
 TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
   std::mt19937 rng(19);
   TestWindow w(16, [](int, int) { return 0.0f; });
   TerrainTree tree = hilly_tree(rng, w);
   Soup soup = random_triangles(rng, 600, {-100.0, 1700.0, -50.0, 500.0, 40.0});
   tree.merge(soup.v, soup.c, soup.t);
+  // And a tree of terrain alone, whose chunks are cut by counting cells.
+  std::mt19937 bare_rng(20);
+  TestWindow bare_window(16, [](int, int) { return 0.0f; });
+  const TerrainTree bare = hilly_tree(bare_rng, bare_window);
   std::uniform_real_distribution<double> xy(-300.0, 1900.0), z(50.0, 900.0);
   Frame serial, chunked;
   std::size_t merged = 0;
@@ -209,6 +213,12 @@ TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
     EXPECT_EQ(chunked.level, serial.level) << "trial " << trial;
     EXPECT_EQ(chunked.crack_triangles, serial.crack_triangles) << "trial " << trial;
     merged += static_cast<std::size_t>(std::count(serial.level.begin(), serial.level.end(), kMergedLevel));
+    o.parallel_min_triangles = std::numeric_limits<std::size_t>::max();
+    bare.traverse(c, o, serial);
+    o.parallel_min_triangles = 0;
+    bare.traverse(c, o, chunked);
+    ASSERT_EQ(chunked.indices, serial.indices) << "terrain alone, trial " << trial;
+    EXPECT_EQ(chunked.level, serial.level) << "terrain alone, trial " << trial;
   }
   EXPECT_GT(merged, 600u);
 }
