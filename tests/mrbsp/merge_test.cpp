@@ -224,15 +224,20 @@ TEST(Merge, AFrameWrittenInParallelChunksIsTheSerialFrameTriangleForTriangle) {
 }
 
 // The LOD choice decides the subtrees below level 1 in parallel once a Frame's traversals are
-// large: from random eyes over a 64-cell window with merged triangles, with and without
-// culling, under both metrics, the choice made so draws the serial frame triangle for
-// triangle (the same cells visited, drawn and balanced) in the brute-force ray order.
-TEST(Merge, AnLodChoiceDecidedInParallelSubtreesDrawsTheSerialFrame) {
-  std::mt19937 rng(23);
-  TestWindow w(64, [](int, int) { return 0.0f; });
-  TerrainTree tree = hilly_tree(rng, w);
-  Soup soup = random_triangles(rng, 400, {-100.0, 6500.0, -50.0, 500.0, 60.0});
-  tree.merge(soup.v, soup.c, soup.t);
+// large, and the walk of the draw order walks them in parallel, building the low alternatives
+// it draws for the first time after it (their vertices flushed in the serial walk's order).
+// Two trees made alike over a 64-cell window with merged triangles, one traversed serially
+// and one split, from seeded eyes, with and without culling, under both metrics: the split
+// frame is the serial one vertex for vertex (the same cells visited, drawn and balanced, the
+// same slots built), in the brute-force ray order.
+TEST(Merge, AnLodChoiceAndWalkInParallelSubtreesDrawTheSerialFrame) {
+  std::mt19937 rng(23), rng_split(23);
+  TestWindow w(64, [](int, int) { return 0.0f; }), w_split(64, [](int, int) { return 0.0f; });
+  TerrainTree serial_tree = hilly_tree(rng, w), split_tree = hilly_tree(rng_split, w_split);
+  const Soup soup = random_triangles(rng, 400, {-100.0, 6500.0, -50.0, 500.0, 60.0});
+  serial_tree.merge(soup.v, soup.c, soup.t);
+  split_tree.merge(soup.v, soup.c, soup.t);
+  ASSERT_GT(serial_tree.merge_stats().pending_slots, 0u) << "low alternatives must wait to be built";
   std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 2500.0);
   Frame serial, split;
   std::size_t balanced = 0, split_frames = 0;
@@ -243,57 +248,24 @@ TEST(Merge, AnLodChoiceDecidedInParallelSubtreesDrawsTheSerialFrame) {
     o.metric = trial % 4 == 3 ? LodMetric::kArea : LodMetric::kError;
     o.threshold_px = o.metric == LodMetric::kArea ? 200.0f : 0.5f + static_cast<float>(trial % 3);
     o.parallel_min_nodes = std::numeric_limits<std::size_t>::max();
-    tree.traverse(c, o, serial);
-    o.parallel_min_nodes = 0;
-    tree.traverse(c, o, split);
-    split_frames += split.subtree_roots_.empty() ? 0 : 1;
-    EXPECT_EQ(order_violations(tree, split, eye, 40, rng, true), 0) << "trial " << trial;
-    ASSERT_EQ(split.indices, serial.indices) << "trial " << trial;
-    EXPECT_EQ(split.level, serial.level) << "trial " << trial;
-    EXPECT_EQ(split.nodes_visited, serial.nodes_visited) << "trial " << trial;
-    EXPECT_EQ(split.lod_histogram, serial.lod_histogram) << "trial " << trial;
-    EXPECT_EQ(split.balanced_cells, serial.balanced_cells) << "trial " << trial;
-    EXPECT_EQ(split.crack_triangles, serial.crack_triangles) << "trial " << trial;
-    balanced += serial.balanced_cells;
-  }
-  EXPECT_GT(balanced, 0u) << "the balance pass must be exercised";
-  EXPECT_GT(split_frames, 16u) << "and the split, where some level-0 cell in view is refined";
-}
-
-// The walk of the draw order in parallel subtrees builds the low alternatives it draws for
-// the first time after the walk: in the serial walk's order, so that their vertices get the
-// same indices. Two trees made alike, one traversed serially and one split, from the same
-// seeded cameras: the same triangles, vertex for vertex, and the same slots built.
-TEST(Merge, AWalkInParallelSubtreesBuildsNewLowSlotsInTheSerialOrder) {
-  std::mt19937 rng_serial(31), rng_split(31);
-  TestWindow w_serial(64, [](int, int) { return 0.0f; }), w_split(64, [](int, int) { return 0.0f; });
-  TerrainTree serial_tree = hilly_tree(rng_serial, w_serial), split_tree = hilly_tree(rng_split, w_split);
-  const Soup soup = random_triangles(rng_serial, 600, {-100.0, 6500.0, -50.0, 300.0, 60.0});
-  serial_tree.merge(soup.v, soup.c, soup.t);
-  split_tree.merge(soup.v, soup.c, soup.t);
-  ASSERT_GT(serial_tree.merge_stats().pending_slots, 0u) << "low alternatives must wait to be built";
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> xy(-500.0, 6900.0), z(300.0, 1500.0);
-  Frame serial, split;
-  std::size_t split_frames = 0;
-  for (int trial = 0; trial < 16; ++trial) {
-    const auto [eye, c] = seeded_view(rng, xy, z, -0.7, 0.3);
-    TraversalOptions o;
-    o.cull = trial % 4 != 0;
-    o.threshold_px = 0.5f + static_cast<float>(trial % 3);
-    o.parallel_min_nodes = std::numeric_limits<std::size_t>::max();
     serial_tree.traverse(c, o, serial);
     o.parallel_min_nodes = 0;
     split_tree.traverse(c, o, split);
     split_frames += split.subtree_roots_.empty() ? 0 : 1;
+    EXPECT_EQ(order_violations(split_tree, split, eye, 40, rng, true), 0) << "trial " << trial;
     ASSERT_EQ(split.indices, serial.indices) << "trial " << trial;
     EXPECT_EQ(split.level, serial.level) << "trial " << trial;
+    EXPECT_EQ(split.nodes_visited, serial.nodes_visited) << "trial " << trial;
     EXPECT_EQ(split.leaves, serial.leaves) << "trial " << trial;
     EXPECT_EQ(split.lod_histogram, serial.lod_histogram) << "trial " << trial;
+    EXPECT_EQ(split.balanced_cells, serial.balanced_cells) << "trial " << trial;
+    EXPECT_EQ(split.crack_triangles, serial.crack_triangles) << "trial " << trial;
     EXPECT_EQ(split_tree.merge_stats().lazy_built_slots, serial_tree.merge_stats().lazy_built_slots) << "trial " << trial;
     EXPECT_EQ(split_tree.positions().size(), serial_tree.positions().size()) << "trial " << trial;
+    balanced += serial.balanced_cells;
   }
-  EXPECT_GT(split_frames, 10u) << "the walk must be split";
+  EXPECT_GT(balanced, 0u) << "the balance pass must be exercised";
+  EXPECT_GT(split_frames, 16u) << "and the split, where some level-0 cell in view is refined";
   EXPECT_GT(split_tree.merge_stats().lazy_built_slots, 2u) << "and slots built by the split walks";
 }
 
