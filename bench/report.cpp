@@ -169,14 +169,19 @@ void translucency_section(std::ostringstream& md, const json& results) {
        << " ms; the window read ahead).\n\n";
     if (t.contains("responsiveness_parts_ms")) {
       const json& parts = t["responsiveness_parts_ms"];
-      md << "| edit | geometry ms | merge ms | vertices ms | frame ms (traversal, upload, draw) |\n|---|---|---|---|---|\n";
+      md << "| edit | geometry ms | merge ms | vertices ms | frame ms (traversal, upload, draw) | triangles drawn | idle tidy ms (slots) | triangles drawn after it |\n|---|---|---|---|---|---|---|---|\n";
       for (const char* edit : {"slice_move", "isovalue_change"}) {
         const std::string e(edit);
         if (!parts.contains(e + "_frame")) continue;
         md << "| " << e << " | " << spread(parts[e + "_geometry"], "%.0f") << " | " << spread(parts[e + "_merge"], "%.0f")
            << " | " << spread(parts[e + "_vertices"], "%.0f") << " | " << spread(parts[e + "_frame"], "%.0f") << " ("
            << num(med(parts[e + "_frame_traversal"]), "%.0f") << ", " << num(med(parts[e + "_frame_upload"]), "%.0f") << ", "
-           << num(med(parts[e + "_frame_draw"]), "%.0f") << ") |\n";
+           << num(med(parts[e + "_frame_draw"]), "%.0f") << ") | ";
+        if (parts.contains(e + "_tidy"))
+          md << spread(parts[e + "_triangles"], "%.0f") << " | " << spread(parts[e + "_tidy"], "%.0f") << " ("
+             << num(med(parts[e + "_tidy_slots"]), "%.0f") << ") | " << spread(parts[e + "_triangles_tidied"], "%.0f") << " |\n";
+        else
+          md << "– | – | – |\n";
       }
       md << "\n";
     }

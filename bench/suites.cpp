@@ -321,7 +321,8 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
   }
   // An edit of one surface, then the re-merge and the next finished frame (total, of it merge),
   // and the parts: the surface made again, the merge, the renderer's vertices brought up to
-  // date (the rest of remerge()), the frame.
+  // date (the rest of remerge()), the frame; then the tidying the viewer does when idle, and
+  // the triangles drawn after the edit and after the tidying.
   std::map<std::string, std::vector<double>> edit_parts;
   const auto time_edit = [&](const std::function<void(int)>& edit, std::vector<double>& total,
                              std::vector<double>& merge, const std::string& name) {
@@ -342,6 +343,14 @@ json translucency_suite(const BenchConfig& c, const Terrain& terrain, const std:
       edit_parts[name + "_vertices"].push_back(remerge - merge.back());
       edit_parts[name + "_frame"].push_back(ms_since(u2));
       total.push_back(ms_since(u0));
+      // What the viewer does once the keys rest: the small BSPs the edit wore built anew
+      // (TerrainTree::tidy), and the pieces the next frame draws then.
+      const auto u3 = Clock::now();
+      const mrbsp::MergeStats tidied = scene.tidy();
+      edit_parts[name + "_tidy"].push_back(ms_since(u3));
+      edit_parts[name + "_tidy_slots"].push_back(static_cast<double>(tidied.rebuilt_slots));
+      edit_parts[name + "_triangles"].push_back(static_cast<double>(f.triangles));
+      edit_parts[name + "_triangles_tidied"].push_back(static_cast<double>(scene.render(pose, true, 45.0, lod_default).triangles));
     }
   };
   time_edit(

@@ -1058,15 +1058,68 @@ CellName cell_name(const TerrainTree::Impl& m, std::uint32_t id) {
   return {level, static_cast<int>(local % c), static_cast<int>(local / c)};
 }
 
+bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
+
+// Builds a slot's small BSP afresh from the pieces every surface sent there, and notes what
+// the build made of them (BspStore::fresh_pieces).
+void build_anew(const TerrainTree::Impl& m, Slot& slot) {
+  slot.store = std::make_unique<BspStore>();
+  SlotBuilder builder(m, *slot.store);
+  std::uint32_t arrivals = 0;
+  for (const auto& [id, s] : m.surfaces) {
+    s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) {
+      builder.add(s, id, piece);
+      ++arrivals;
+    });
+  }
+  if (is_low(slot.key)) {
+    const CellName c = cell_name(m, slot.key / 2);
+    builder.build_low(c.level, c.ci, c.cj);
+  } else {
+    builder.build_autopartition();
+  }
+  slot.store->fresh_pieces = slot.store->pieces;
+  slot.store->arrivals = slot.store->fresh_arrivals = arrivals;
+}
+
 template <class T>
 void release(std::vector<T>& v) {
   std::vector<T>().swap(v);
 }
 
-bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
+// Unlinks the nodes a removal left vacant: no polygon of their own, no dropped side, and
+// nothing on one of their sides. Such a plane separates nothing, but it would go on cutting
+// whatever is inserted later (after a slice moved, the planes of its old pieces cut the new
+// ones). The node is replaced by its other side (or by nothing); unlinked nodes stay in
+// `nodes`, unreached, until the slot is built anew. Children still follow their parents.
+void prune_vacant(BspStore& st) {
+  std::vector<std::uint32_t> held(st.nodes.size(), 0);  // polygons in each node's subtree
+  for (std::size_t k = st.nodes.size(); k-- > 0;) {
+    const BspNode& bn = st.nodes[k];
+    held[k] = bn.count;
+    for (const std::int32_t child : {bn.back, bn.front})
+      if (child >= 0) held[k] += held[static_cast<std::size_t>(child)];
+  }
+  const auto empty = [&](std::int32_t c) { return c == -1 || (c >= 0 && held[static_cast<std::size_t>(c)] == 0); };
+  const auto resolve = [&](std::int32_t c) {
+    while (c >= 0) {
+      const BspNode& bn = st.nodes[static_cast<std::size_t>(c)];
+      if (bn.count != 0 || bn.back == kDropSide || bn.front == kDropSide) return c;
+      if (empty(bn.back) && empty(bn.front)) return std::int32_t{-1};
+      if (!empty(bn.back) && !empty(bn.front)) return c;
+      c = empty(bn.back) ? bn.front : bn.back;
+    }
+    return c;
+  };
+  st.root = resolve(st.root);
+  for (BspNode& bn : st.nodes) {
+    bn.back = resolve(bn.back);
+    bn.front = resolve(bn.front);
+  }
+}
 
-// Removes the polygons of the surfaces in `ids` (sorted) from a store; returns the references
-// dropped with them. Its top becomes that of what stays.
+// Removes the polygons of the surfaces in `ids` (sorted) from a store and prunes the nodes
+// left vacant; returns the references dropped with them. Its top becomes that of what stays.
 std::size_t remove_surfaces(BspStore& st, const std::vector<std::uint32_t>& ids, const std::vector<glm::vec3>& positions) {
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
@@ -1091,6 +1144,7 @@ std::size_t remove_surfaces(BspStore& st, const std::vector<std::uint32_t>& ids,
     bn.first = first;
     bn.count = static_cast<std::uint32_t>(polys.size()) - first;
   }
+  prune_vacant(st);
   const std::size_t removed = st.refs.size() - refs.size();
   refs.shrink_to_fit();
   polys.shrink_to_fit();
@@ -1341,18 +1395,31 @@ void TerrainTree::Impl::make_content() {
   }
 }
 
-void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std::vector<SlotKey> touched) {
+// A slot whose pieces per arrived piece grew past kWorn times what its last build made of them
+// is worn (MergeStats::worn_slots; TerrainTree::tidy builds it anew).
+constexpr double kWorn = 1.15;
+
+void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std::vector<SlotKey> touched, bool rebuild) {
   const auto t0 = Clock::now();
   std::vector<std::uint32_t> changed = changed_in;
   std::sort(changed.begin(), changed.end());
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
 
-  // Each touched slot, in parallel: its old store less the changed surfaces' polygons, with
-  // their new pieces inserted; built anew from every surface's pieces when it was empty or
-  // would be worn (far more planes than polygons); a low slot never drawn stays unbuilt.
+  // Each touched slot, in parallel: its old store less the changed surfaces' polygons (and the
+  // planes they leave vacant, prune_vacant), with their new pieces inserted; built anew from
+  // every surface's pieces when it was empty or would be worn out (far more planes than
+  // polygons), or with `rebuild`; a low slot never drawn stays unbuilt. Insertion sends the new
+  // pieces down planes chosen for other polygons, which cut them more than planes chosen for
+  // them, and what it cut stays cut (BspStore::worn, tidy()). On the benchmark scene over
+  // N44W072 (6 isosurfaces, a slice; its first view draws 198k triangles), twelve slice moves
+  // left frames of 213-228k triangles and twelve isovalue changes 230-241k, and without the
+  // pruning 243-279k after two of each; building anew every slot whose changed pieces were
+  // over a tenth of what stays kept them at 196-210k, but took a slice move's merge from
+  // 99-146 to 171-232 ms (side by side): tidy() spends that when the viewer is idle instead.
   std::vector<Slot> fresh(touched.size());
   std::vector<std::size_t> removed(touched.size(), 0);
+  std::vector<std::uint8_t> inserted(touched.size(), 0);
   // Largest first (old polygons and arrivals), one slot at a time: a few slots of the coarsest
   // cells hold most pieces, and TBB's default chunks put neighbouring keys (those slots) on one
   // thread. On the benchmark scene over N44W072 the initial merge's slot phase went from
@@ -1374,9 +1441,12 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     slot.key = key;
     slot.pending = 0;
     slot.top = -1e30f;
+    std::size_t arriving = 0;  // pieces of the changed surfaces
     for (const auto& [id, s] : surfaces) {
+      const bool changed_here = std::binary_search(changed.begin(), changed.end(), id);
       s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) {
         ++slot.pending;
+        arriving += changed_here;
         for (std::uint32_t r : piece) slot.top = std::max(slot.top, static_cast<float>(s.vertices[r].z));
       });
     }
@@ -1387,24 +1457,32 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
       return;
     }
     if (is_low(key) && !slot.built) return;  // built when first drawn
-    bool anew = !slot.built;
+    // The changed surfaces' new pieces inserted into the BSP kept.
+    const auto insert_changed = [&] {
+      SlotBuilder builder(*this, *slot.store);
+      for (const auto& [id, s] : surfaces) {
+        if (!std::binary_search(changed.begin(), changed.end(), id)) continue;
+        s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
+      }
+      if (is_low(key)) {
+        const CellName c = cell_name(*this, key / 2);
+        builder.build_low(c.level, c.ci, c.cj);
+      } else {
+        builder.build_autopartition();
+      }
+    };
+    bool anew = !slot.built || rebuild;
     if (slot.built) {
-      removed[k] = remove_surfaces(*slot.store, changed, positions);
-      anew = slot.store->pieces == 0 || slot.store->nodes.size() > 4 * slot.store->pieces + 64;
+      if (!rebuild) removed[k] = remove_surfaces(*slot.store, changed, positions);
+      anew = anew || slot.store->pieces == 0 || slot.store->nodes.size() > 4 * slot.store->pieces + 64;
       if (anew) removed[k] += slot.store->refs.size();
     }
-    if (anew) slot.store = std::make_unique<BspStore>();
-    SlotBuilder builder(*this, *slot.store);
-    for (const auto& [id, s] : surfaces) {
-      if (!anew && !std::binary_search(changed.begin(), changed.end(), id)) continue;
-      s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
+    if (!anew) {
+      if (arriving > 0) insert_changed();
+      inserted[k] = arriving > 0;
+      slot.store->arrivals = slot.pending;
     }
-    if (is_low(key)) {
-      const CellName c = cell_name(*this, key / 2);
-      builder.build_low(c.level, c.ci, c.cj);
-    } else {
-      builder.build_autopartition();
-    }
+    if (anew) build_anew(*this, slot);
     slot.built = true;
     slot.pending = 0;
     slot.store->bound_nodes(positions);  // read only here: flushes come after
@@ -1432,6 +1510,9 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   slots.shrink_to_fit();
   if (surfaces.empty()) release(surfaces);
   merge_stats.rebuilt_slots += touched.size();
+  merge_stats.inserted_slots += static_cast<std::size_t>(std::count(inserted.begin(), inserted.end(), 1));
+  merge_stats.worn_slots = 0;
+  for (const Slot& slot : slots) merge_stats.worn_slots += slot.store && slot.store->worn(kWorn);
   for (std::size_t r : removed) dead_refs += r;
   std::size_t staged = 0;
   for (const Slot& slot : slots) staged += slot.store ? slot.store->staged_count() : 0;
@@ -1479,13 +1560,7 @@ void TerrainTree::Impl::build_pending(std::span<const std::int32_t> ks) {
   // vertices staged; the flushes, which append to positions, come after all of them.
   tbb::parallel_for(std::size_t{0}, ks.size(), [&](std::size_t q) {
     Slot& slot = slots[static_cast<std::size_t>(ks[q])];
-    slot.store = std::make_unique<BspStore>();
-    SlotBuilder builder(*this, *slot.store);
-    for (const auto& [id, s] : surfaces) {
-      s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
-    }
-    const CellName c = cell_name(*this, slot.key / 2);
-    builder.build_low(c.level, c.ci, c.cj);
+    build_anew(*this, slot);
     slot.built = true;
     slot.pending = 0;
     slot.store->bound_nodes(positions);  // read only here: flushes come after
@@ -1528,6 +1603,7 @@ void keys_of(const SurfacePieces& s, std::vector<SlotKey>& out) {
 void TerrainTree::Impl::redistribute_all() {
   const auto t0 = Clock::now();
   merge_stats.rebuilt_slots = 0;
+  merge_stats.inserted_slots = 0;
   merge_stats.build_ms = 0.0;
   merge_stats.lazy_built_slots = 0;
   merge_stats.lazy_build_ms = 0.0;
@@ -1555,6 +1631,7 @@ void TerrainTree::Impl::redistribute_all() {
 void TerrainTree::Impl::shift_merged(int di, int dj) {
   const auto t0 = Clock::now();
   merge_stats.rebuilt_slots = 0;
+  merge_stats.inserted_slots = 0;
   merge_stats.build_ms = 0.0;
   merge_stats.lazy_built_slots = 0;
   merge_stats.lazy_build_ms = 0.0;
@@ -1668,6 +1745,7 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   Impl& m = *impl_;
   const auto t0 = Clock::now();
   m.merge_stats.rebuilt_slots = 0;
+  m.merge_stats.inserted_slots = 0;
   m.merge_stats.build_ms = 0.0;
   m.merge_stats.lazy_built_slots = 0;
   m.merge_stats.lazy_build_ms = 0.0;
@@ -1731,6 +1809,21 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   m.merge_stats.distribute_ms = ms_since(t0);
   for (std::size_t k : changed) keys_of(m.surfaces[k].second, touched);
   m.update(changed_ids, std::move(touched));
+  m.merge_stats.merge_ms = ms_since(t0);
+  return m.merge_stats;
+}
+
+MergeStats TerrainTree::tidy() {
+  Impl& m = *impl_;
+  const auto t0 = Clock::now();
+  m.merge_stats.rebuilt_slots = 0;
+  m.merge_stats.inserted_slots = 0;
+  m.merge_stats.build_ms = 0.0;
+  m.merge_stats.distribute_ms = 0.0;
+  std::vector<SlotKey> worn;
+  for (const Slot& slot : m.slots)
+    if (slot.store && slot.store->worn(kWorn)) worn.push_back(slot.key);
+  if (!worn.empty()) m.update({}, std::move(worn), true);
   m.merge_stats.merge_ms = ms_since(t0);
   return m.merge_stats;
 }

@@ -111,6 +111,8 @@ struct MergeStats {
   double lazy_build_ms = 0.0;       // what building those cost
   std::size_t merged_vertices = 0;  // vertices of the stored pieces (positions() after merged_base())
   std::size_t rebuilt_slots = 0;    // of the last change: small BSPs made again
+  std::size_t inserted_slots = 0;   // of those: new pieces inserted into the BSP kept, not built anew
+  std::size_t worn_slots = 0;       // after it: small BSPs that insertions cut past 1.15x a build (tidy())
   double distribute_ms = 0.0;       // of the last change: sending its surfaces through the tree
   double build_ms = 0.0;            // of the last change: the small BSPs and the vertices
   double merge_ms = 0.0;            // of the last change: all of it
@@ -293,6 +295,13 @@ class TerrainTree {
   MergeStats set_surface(std::uint32_t id, const SurfaceInput& surface);
   // Several at once (one re-merge): surfaces[k] replaces id ids[k].
   MergeStats set_surfaces(std::span<const std::uint32_t> ids, std::span<const SurfaceInput> surfaces);
+  // Insertion is fast, but the planes it sends new pieces down were chosen for other polygons,
+  // and what it cuts stays cut: after a few edits a small BSP can hold a fifth more pieces
+  // than one built for what it holds now. tidy() builds anew every small BSP whose pieces per
+  // arrived piece grew past 1.15 times what its last build made (MergeStats::worn_slots), for
+  // a caller with time to spare (the viewer when idle). Returns what it cost; the image does
+  // not change.
+  MergeStats tidy();
   // Replaces every surface by one (id 0).
   MergeStats merge(std::span<const glm::dvec3> vertices, std::span<const glm::u8vec4> colors,
                    std::span<const std::uint32_t> triangles);

@@ -97,6 +97,13 @@ struct BspStore {
   std::uint32_t pieces = 0;   // merged polygons (terrain triangles not counted)
   std::uint32_t dropped = 0;  // pieces found below the low triangles and dropped
   float top = -1e30f;         // highest merged vertex ever put in (an upper bound after removals)
+  // The pieces that arrived (before it cut them), now and when it was last built anew, and its
+  // pieces then. Insertions cut more than a build, which chooses its planes for the pieces:
+  // worn() when its pieces per arrived piece grew past `factor` times what the build made.
+  std::uint32_t arrivals = 0, fresh_arrivals = 0, fresh_pieces = 0;
+  bool worn(double factor) const {
+    return static_cast<double>(pieces) * fresh_arrivals > factor * static_cast<double>(fresh_pieces) * arrivals;
+  }
   std::size_t bytes() const;
   std::size_t staged_count() const { return staged ? staged->positions.size() : 0; }
   // Sets every node's subtree box (boxes, box_base, box_step) from its polygons' vertices: references
@@ -311,7 +318,8 @@ struct TerrainTree::Impl {
   // `touched` holds every slot key their old or new pieces reach: removes their old polygons
   // from those slots and inserts the new ones (a slot left empty or worn is built anew from
   // every surface's pieces), then flushes the vertices and remakes the cell content.
-  void update(const std::vector<std::uint32_t>& changed, std::vector<SlotKey> touched);
+  // With `rebuild`, `changed` is empty and every slot in `touched` is built anew (tidy()).
+  void update(const std::vector<std::uint32_t>& changed, std::vector<SlotKey> touched, bool rebuild = false);
   void redistribute_all();  // after refresh(): every surface again, every slot anew
   // Builds slots[k] (a low slot first drawn) and flushes its vertices.
   void build_pending(std::size_t k);

@@ -407,6 +407,13 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   return volumes_.figures();
 }
 
+mrbsp::MergeStats SceneRenderer::tidy() {
+  if (scene_->tree().merge_stats().worn_slots == 0) return scene_->tree().merge_stats();
+  const mrbsp::MergeStats stats = scene_->tidy();
+  if (renderer_) sync_vertices(*renderer_);
+  return stats;
+}
+
 volume::LinkProfile SceneRenderer::link_profile(const volume::Transmitter& tx, double rx_lat, double rx_lon,
                                                 double rx_height_agl, const volume::RfOptions& options) const {
   const volume::DemExtent area{std::min(tx.lat, rx_lat), std::max(tx.lat, rx_lat), std::min(tx.lon, rx_lon),

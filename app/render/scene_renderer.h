@@ -214,6 +214,10 @@ class SceneRenderer {
   // (what terravol view does after a key). Returns what the merge cost.
   scene::VolumeLayer& volumes() { return volumes_; }
   const scene::MergeFigures& remerge();
+  // When edits wore small BSPs (the tree's MergeStats::worn_slots), builds them anew and brings
+  // the renderer's vertices up to date; the image does not change, later frames draw fewer
+  // pieces. For idle moments (terravol view between keys). Returns the tree's figures.
+  mrbsp::MergeStats tidy();
   // The objects on the terrain (set_fixed_level for benchmarks and tests; takes effect at the
   // next prepare()).
   scene::ObjectLayer& objects() { return objects_; }

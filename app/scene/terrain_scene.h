@@ -109,6 +109,8 @@ class TerrainScene {
   mrbsp::MergeStats set_surfaces(std::span<const std::uint32_t> ids, std::span<const mrbsp::SurfaceInput> surfaces) {
     return tree_.set_surfaces(ids, surfaces);
   }
+  // Builds anew the small BSPs edits wore (TerrainTree::tidy).
+  mrbsp::MergeStats tidy() { return tree_.tidy(); }
   double build_ms() const { return build_ms_; }  // the tree's constructor alone, wall clock
 
   // Bilinear height (metres, datum) at a geographic point; points outside the window are

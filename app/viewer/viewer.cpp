@@ -197,6 +197,9 @@ ordered_json box_json(const Box& b) {
 }
 
 constexpr auto kOverlayPeriod = std::chrono::milliseconds(250);
+// Quiet this long after the last key (a held key repeats faster), the viewer tidies the tree:
+// the small BSPs edits wore are built anew (TerrainTree::tidy).
+constexpr auto kTidyAfter = std::chrono::milliseconds(400);
 
 // `given`, or when it is empty the first STEM-NNN.png (NNN from 001) not in the current folder.
 std::filesystem::path given_or_next_free(const std::filesystem::path& given, const char* stem) {
@@ -275,6 +278,7 @@ class Viewer {
   int drag_x_ = 0, drag_y_ = 0;
   std::set<std::string> held_, tapped_;
   Clock::time_point start_, last_tick_;
+  Clock::time_point last_key_;  // the last key pressed
 
   // Figures.
   std::size_t frames_ = 0, screenshots_ = 0, key_presses_ = 0;
@@ -517,6 +521,7 @@ scene::FlightInput Viewer::input() const {
 
 void Viewer::key_press(const std::string& key) {
   ++key_presses_;
+  last_key_ = Clock::now();
   static const std::set<std::string> kMotion{"w",  "s",    "a",    "d",     "r",       "f",      "Prior",
                                              "Next", "Up", "Down", "Left", "Right", "Shift_L", "Shift_R"};
   if (kMotion.count(key) > 0) {
@@ -776,6 +781,10 @@ void Viewer::tick() {
   if (dirty_ || screenshot_pending_) {
     dirty_ = false;
     draw_frame();
+  } else if (held_.empty() && now - last_key_ >= kTidyAfter && !pipeline_->slide_pending() &&
+             pipeline_->terrain().tree().merge_stats().worn_slots > 0) {
+    pipeline_->tidy();
+    dirty_ = true;  // the same image, from fewer pieces
   }
 }
 

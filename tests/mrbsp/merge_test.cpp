@@ -486,6 +486,23 @@ TEST(Merge, EditsKeepTheOrderAndDrawEachVisiblePartOnce) {
   tree.set_surface(7, input(d));
   tree.set_surface(4, input(b));
   check(joined({&b, &c, &d}), "after adding 7 and replacing 4");
+  // A change small against what a slot holds is inserted into the slot's BSP, not built anew.
+  const Soup e = random_soup(rng, 1, false);
+  const MergeStats small = tree.set_surface(11, input(e));
+  EXPECT_GT(small.inserted_slots, 0u);
+  EXPECT_LT(small.inserted_slots, small.rebuilt_slots + 1);
+  check(joined({&b, &c, &d, &e}), "after adding one triangle as 11");
+  // Edits wear the small BSPs (insertion cuts the new pieces by planes chosen for others);
+  // tidy() builds the worn ones anew: fewer pieces, the same surfaces, in order.
+  for (int k = 0; k < 6; ++k) tree.set_surface(7, input(k % 2 ? d : a));  // ends as d
+  const MergeStats worn = tree.merge_stats();
+  ASSERT_GT(worn.worn_slots, 0u) << "six replacements wear some slot";
+  const MergeStats tidied = tree.tidy();
+  EXPECT_EQ(tidied.rebuilt_slots, worn.worn_slots);
+  EXPECT_EQ(tidied.worn_slots, 0u);
+  EXPECT_LT(tidied.stored_polygons, worn.stored_polygons);
+  check(joined({&b, &c, &d, &e}), "after tidying");
+  EXPECT_EQ(tree.tidy().rebuilt_slots, 0u) << "nothing is worn any more";
 }
 
 // Texture coordinates ride along with the colours: on a sheet whose coordinates are a linear
