@@ -279,6 +279,7 @@ class Viewer {
   std::set<std::string> held_, tapped_;
   Clock::time_point start_, last_tick_;
   Clock::time_point last_key_;  // the last key pressed
+  std::size_t tidied_slots_ = 0;  // small BSPs tidy() built anew so far
 
   // Figures.
   std::size_t frames_ = 0, screenshots_ = 0, key_presses_ = 0;
@@ -783,7 +784,7 @@ void Viewer::tick() {
     draw_frame();
   } else if (held_.empty() && now - last_key_ >= kTidyAfter && !pipeline_->slide_pending() &&
              pipeline_->terrain().tree().merge_stats().worn_slots > 0) {
-    pipeline_->tidy();
+    tidied_slots_ += pipeline_->tidy().rebuilt_slots;
     dirty_ = true;  // the same image, from fewer pieces
   }
 }
@@ -1172,6 +1173,9 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   j["markers"] = volumes.markers_shown();
   j["objects"] = pipeline_->objects().visible();
   j["last_merge_ms"] = last_merge_ms_;
+  // Small BSPs edits wore and the viewer has not yet tidied, and those it has tidied so far.
+  j["worn_slots"] = pipeline_->terrain().tree().merge_stats().worn_slots;
+  j["tidied_slots"] = tidied_slots_;
   j["message"] = message_;
   if (pick_) {
     const io::Geodetic& g = pick_->point.where;
@@ -1186,8 +1190,9 @@ void Viewer::write_status(double agl, double speed, const mrbsp::Camera& camera)
   }
   if (!profile_status_.is_null()) j["profile"] = profile_status_;
   // Nothing will draw another frame until something happens: no key held, no slide read
-  // ahead, no overlay refresh or screenshot due.
-  j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_;
+  // ahead, no overlay refresh or screenshot due, no worn small BSP left to tidy.
+  j["idle"] = held_.empty() && !pipeline_->slide_pending() && !overlay_stale_ && !screenshot_pending_ && !dirty_ &&
+              pipeline_->terrain().tree().merge_stats().worn_slots == 0;
   j["window"] = {{"cells", w.cells},
                  {"row0", w.row0},
                  {"col0", w.col0},

@@ -612,6 +612,12 @@ TEST(ViewCli, VolumeKeysToggleMoveTheSliceAndChangeTheIsovalueAndSayHowLong) {
   s = v.settle();
   EXPECT_DOUBLE_EQ(s["volumes"][0]["isovalues"][0].get<double>(), 112.0);
   EXPECT_GT(s["merged_triangles"].get<std::size_t>(), 0u);
+
+  // Edits wear small BSPs; once the keys rest the viewer tidies them (TerrainTree::tidy).
+  for (const char* key : {"bracketright", "period", "bracketleft", "comma", "bracketright", "period"}) v.tap(key);
+  s = v.settle();
+  EXPECT_EQ(s["worn_slots"].get<std::size_t>(), 0u) << "settled means tidied";
+  EXPECT_GT(s["tidied_slots"].get<std::size_t>(), 0u);
   v.xdo("key q");
   EXPECT_EQ(v.wait_exit(15.0), 0) << v.stderr_text();
 }
