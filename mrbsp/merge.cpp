@@ -1594,6 +1594,15 @@ void check_surface(const SurfaceInput& s) {
   }
 }
 
+// Zeroes the figures of the last change (MergeStats) before a new one.
+void start_change(MergeStats& s) {
+  s.rebuilt_slots = 0;
+  s.inserted_slots = 0;
+  s.build_ms = 0.0;
+  s.lazy_built_slots = 0;
+  s.lazy_build_ms = 0.0;
+}
+
 void keys_of(const SurfacePieces& s, std::vector<SlotKey>& out) {
   for (const SurfacePieces::Run& run : s.runs) out.push_back(run.slot);
 }
@@ -1602,11 +1611,7 @@ void keys_of(const SurfacePieces& s, std::vector<SlotKey>& out) {
 
 void TerrainTree::Impl::redistribute_all() {
   const auto t0 = Clock::now();
-  merge_stats.rebuilt_slots = 0;
-  merge_stats.inserted_slots = 0;
-  merge_stats.build_ms = 0.0;
-  merge_stats.lazy_built_slots = 0;
-  merge_stats.lazy_build_ms = 0.0;
+  start_change(merge_stats);
   std::vector<SurfacePieces*> list;
   for (auto& [id, s] : surfaces) list.push_back(&s);
   distribute_all(list);
@@ -1630,11 +1635,7 @@ void TerrainTree::Impl::redistribute_all() {
 
 void TerrainTree::Impl::shift_merged(int di, int dj) {
   const auto t0 = Clock::now();
-  merge_stats.rebuilt_slots = 0;
-  merge_stats.inserted_slots = 0;
-  merge_stats.build_ms = 0.0;
-  merge_stats.lazy_built_slots = 0;
-  merge_stats.lazy_build_ms = 0.0;
+  start_change(merge_stats);
   // The overlap in the moved window's indices; a cell there was (ci + di / s, cj + dj / s).
   const Region kept{std::max(0, -di), std::max(0, -dj), n - std::max(0, di), n - std::max(0, dj)};
   // An outside place lies where one lay before when both are one level-0 cell wide between the
@@ -1744,11 +1745,7 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
   for (const SurfaceInput& s : inputs) check_surface(s);
   Impl& m = *impl_;
   const auto t0 = Clock::now();
-  m.merge_stats.rebuilt_slots = 0;
-  m.merge_stats.inserted_slots = 0;
-  m.merge_stats.build_ms = 0.0;
-  m.merge_stats.lazy_built_slots = 0;
-  m.merge_stats.lazy_build_ms = 0.0;
+  start_change(m.merge_stats);
   // Replacing every surface there is, or the first with texture coordinates coming or the last
   // going: start from nothing (no old polygons to remove).
   // The given ids sorted, so that each stored surface is looked up in O(log k): with thousands
@@ -1816,9 +1813,7 @@ MergeStats TerrainTree::set_surfaces(std::span<const std::uint32_t> ids, std::sp
 MergeStats TerrainTree::tidy() {
   Impl& m = *impl_;
   const auto t0 = Clock::now();
-  m.merge_stats.rebuilt_slots = 0;
-  m.merge_stats.inserted_slots = 0;
-  m.merge_stats.build_ms = 0.0;
+  start_change(m.merge_stats);
   m.merge_stats.distribute_ms = 0.0;
   std::vector<SlotKey> worn;
   for (const Slot& slot : m.slots)
