@@ -316,8 +316,9 @@ struct TerrainTree::Impl {
   void distribute_all(const std::vector<SurfacePieces*>& list) const;
   // After the surfaces with ids `changed` were replaced (their pieces distributed anew) and
   // `touched` holds every slot key their old or new pieces reach: removes their old polygons
-  // from those slots and inserts the new ones (a slot left empty or worn is built anew from
-  // every surface's pieces), then flushes the vertices and remakes the cell content.
+  // from those slots and inserts the new ones (a slot left empty or worn out, far more planes
+  // than polygons, is built anew from every surface's pieces), then flushes the vertices and
+  // remakes the cell content.
   // With `rebuild`, `changed` is empty and every slot in `touched` is built anew (tidy()).
   void update(const std::vector<std::uint32_t>& changed, std::vector<SlotKey> touched, bool rebuild = false);
   void redistribute_all();  // after refresh(): every surface again, every slot anew
