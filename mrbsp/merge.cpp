@@ -1060,6 +1060,18 @@ CellName cell_name(const TerrainTree::Impl& m, std::uint32_t id) {
 
 bool is_low(SlotKey key) { return key < kOutsideKey0 && key % 2 == static_cast<SlotKey>(SlotKind::kLow); }
 
+// Builds a slot's small BSP from what `builder` was given, or inserts it into the BSP the
+// store already has: a low slot's against its cell's two triangles, any other's as an
+// autopartition.
+void build_slot(const TerrainTree::Impl& m, SlotKey key, SlotBuilder& builder) {
+  if (is_low(key)) {
+    const CellName c = cell_name(m, key / 2);
+    builder.build_low(c.level, c.ci, c.cj);
+  } else {
+    builder.build_autopartition();
+  }
+}
+
 // Builds a slot's small BSP afresh from the pieces every surface sent there, and notes what
 // the build made of them (BspStore::fresh_pieces).
 void build_anew(const TerrainTree::Impl& m, Slot& slot) {
@@ -1072,12 +1084,7 @@ void build_anew(const TerrainTree::Impl& m, Slot& slot) {
       ++arrivals;
     });
   }
-  if (is_low(slot.key)) {
-    const CellName c = cell_name(m, slot.key / 2);
-    builder.build_low(c.level, c.ci, c.cj);
-  } else {
-    builder.build_autopartition();
-  }
+  build_slot(m, slot.key, builder);
   slot.store->fresh_pieces = slot.store->pieces;
   slot.store->arrivals = slot.store->fresh_arrivals = arrivals;
 }
@@ -1464,12 +1471,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
         if (!std::binary_search(changed.begin(), changed.end(), id)) continue;
         s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
       }
-      if (is_low(key)) {
-        const CellName c = cell_name(*this, key / 2);
-        builder.build_low(c.level, c.ci, c.cj);
-      } else {
-        builder.build_autopartition();
-      }
+      build_slot(*this, key, builder);
     };
     bool anew = !slot.built || rebuild;
     if (slot.built) {

@@ -1118,22 +1118,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     }
     leaves.swap(joined);
   }
-  bool any_unbuilt = false;
+  // Rarely any (a region drawn at a level for the first time): the vector allocates only then.
+  std::vector<std::int32_t> in_order;
   for (const std::int32_t slot : unbuilt) {
-    any_unbuilt = any_unbuilt || slot >= 0 || !frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt.empty();
-  }
-  if (any_unbuilt) {  // rare: a region drawn at a level for the first time
-    std::vector<std::int32_t> in_order;
-    for (const std::int32_t slot : unbuilt) {
-      if (slot >= 0) {
-        in_order.push_back(slot);
-        continue;
-      }
-      const auto& part = frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt;
-      in_order.insert(in_order.end(), part.begin(), part.end());
+    if (slot >= 0) {
+      in_order.push_back(slot);
+      continue;
     }
-    lazy.build_pending(in_order);
+    const auto& part = frame.subtrees_[static_cast<std::size_t>(-1 - slot)].unbuilt;
+    in_order.insert(in_order.end(), part.begin(), part.end());
   }
+  lazy.build_pending(in_order);
   if (occlusion) {
     std::size_t drawn = 0;  // the drawn cells of the LOD choice, culled or not
     for (int level = 0; level < m.levels; ++level)
