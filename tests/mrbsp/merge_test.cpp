@@ -432,6 +432,51 @@ TEST(Merge, PiecesAboveTheTerrainStayWholeAndPiecesBelowItAreDropped) {
   EXPECT_GT(stats.dropped_pieces, 0u);
 }
 
+// A height field on lines x = c and y = c (as a slice of a geographic volume lies on its
+// lattice's meridians and parallels), wavy and entirely above the terrain: its small BSP
+// separates its cells by those planes (axis_split) and cuts none of its triangles, and it
+// keeps the brute-force ray order from eyes above, beside and below its crests.
+TEST(Merge, AHeightFieldOnAxisLinesAboveTheTerrainIsStoredWithoutACut) {
+  std::mt19937 rng(5);
+  TestWindow w(16, [](int i, int j) { return static_cast<float>(10 * i + 5 * j); });
+  TerrainTree tree(w.view(), 3);
+  test::TriangleSoup sheet;
+  constexpr int kCols = 48, kRows = 40;
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  // Uneven lines over [400, 1200]^2, through the level-0 cells' planes x = 800 and y = 800
+  // (the tree cuts what crosses its own planes; the test is about the small BSP's).
+  std::vector<double> xs, ys;
+  for (int i = 0; i <= kCols; ++i) xs.push_back(400.0 + 800.0 * (i + (i % (kCols / 2) ? jitter(rng) : 0.0)) / kCols);
+  for (int j = 0; j <= kRows; ++j) ys.push_back(400.0 + 800.0 * (j + (j % (kRows / 2) ? jitter(rng) : 0.0)) / kRows);
+  for (int j = 0; j <= kRows; ++j)
+    for (int i = 0; i <= kCols; ++i) {
+      sheet.v.emplace_back(xs[i], ys[j], 600.0 + 200.0 * std::sin(xs[i] / 140.0) * std::cos(ys[j] / 190.0));
+      sheet.c.emplace_back(40, 90, 200, 110);
+    }
+  for (std::uint32_t j = 0; j < kRows; ++j)
+    for (std::uint32_t i = 0; i < kCols; ++i) {
+      const std::uint32_t a = j * (kCols + 1) + i, b = a + 1, d = a + kCols + 1, e = d + 1;
+      if ((i + j) % 2) {
+        sheet.t.insert(sheet.t.end(), {a, b, e, a, e, d});
+      } else {
+        sheet.t.insert(sheet.t.end(), {a, b, d, b, e, d});
+      }
+    }
+  const MergeStats stats = tree.merge(sheet.v, sheet.c, sheet.t);
+  EXPECT_EQ(stats.input_triangles, sheet.t.size() / 3);
+  EXPECT_EQ(stats.stored_polygons, stats.input_triangles) << "no triangle is cut";
+  std::uniform_real_distribution<double> xy(200.0, 1400.0), dir(-1.0, 1.0);
+  Frame f;
+  for (int trial = 0; trial < 6; ++trial) {
+    const glm::dvec3 eye(xy(rng), xy(rng), 300.0 + 150.0 * trial);
+    const Camera cam = camera_at(eye, {dir(rng), dir(rng), -0.4});
+    TraversalOptions o;
+    o.cull = trial % 2 == 0;
+    tree.traverse(cam, o, f);
+    EXPECT_EQ(order_violations(tree, f, eye, 100, rng, true), 0) << "trial " << trial;
+  }
+}
+
 // An edit removes one surface's polygons and inserts its new ones (BSP insertion), touching
 // only the slots they reach. After a sequence of edits the tree still draws every visible part
 // of every surface once, in back-to-front order (brute force references as above), and a
