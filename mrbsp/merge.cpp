@@ -1656,6 +1656,7 @@ void check_surface(const SurfaceInput& s) {
 void start_change(MergeStats& s) {
   s.rebuilt_slots = 0;
   s.inserted_slots = 0;
+  s.distribute_ms = 0.0;
   s.build_ms = 0.0;
   s.lazy_built_slots = 0;
   s.lazy_build_ms = 0.0;
@@ -1872,7 +1873,6 @@ MergeStats TerrainTree::tidy() {
   Impl& m = *impl_;
   const auto t0 = Clock::now();
   start_change(m.merge_stats);
-  m.merge_stats.distribute_ms = 0.0;
   std::vector<SlotKey> worn;
   for (const Slot& slot : m.slots)
     if (slot.store && slot.store->worn(kWorn)) worn.push_back(slot.key);
