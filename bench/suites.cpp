@@ -456,6 +456,68 @@ json scaling_suite(const BenchConfig& c, const std::vector<Terrain>& terrains) {
   return list;
 }
 
+namespace {
+
+// The viewer's frames through window slides (issue 13, "viewer frame during a slide"): the
+// pipeline as `terravol view` runs it (Sliding::kAsynchronous: the moved window read and shaded
+// on a worker thread while the frames go on; at the first frame after that, the tree slid and
+// the renderer's vertices replaced on this thread), terrain only, the camera flying east 1000 m
+// above the ground, a twentieth of a coarsest cell per frame, until two slides have landed or
+// the mosaic's east edge is near. Each frame's wall time (prepare and draw, the viewer's loop
+// without its overlay) counts as quiet (no slide under way), during (the worker reading and
+// shading) or landing (the frame that slides the tree). No figures when no slide landed (the
+// window spans the mosaic east of its centre).
+json viewer_slides(const BenchConfig& c, const Terrain& terrain, const io::Mosaic& mosaic) {
+  app::render::SceneOptions options = bench_scene_options();
+  options.sliding = app::render::Sliding::kAsynchronous;
+  app::render::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), options);
+  const app::scene::WindowBounds b = scene.terrain().bounds();
+  app::scene::CameraPose pose;
+  pose.lat = 0.5 * (b.south + b.north);
+  pose.lon = 0.5 * (b.west + b.east);
+  pose.alt = 1000.0;
+  pose.heading_deg = 270.0;  // looking back west, over the window: the same kind of view throughout
+  pose.pitch_deg = -15.0;
+  const double coarsest = (b.east - b.west) / scene.terrain().cells() * (1 << (scene.terrain().tree().levels() - 1));
+  const io::Georef& g = mosaic.georef();
+  const double east = g.x0 + (mosaic.cols() - 1) * g.dx - coarsest;
+  const mrbsp::TraversalOptions two_px = lod(mrbsp::LodMetric::kError, 2.0);
+  scene.render(pose, true, 45.0, two_px);  // warm-up
+  std::vector<double> quiet, during, landing, tree, vertices;
+  for (int f = 0; f < 1000 && landing.size() < 2 && pose.lon + coarsest / 20.0 < east; ++f) {
+    pose.lon += coarsest / 20.0;
+    const bool pending = scene.slide_pending();
+    const auto t0 = Clock::now();
+    const app::render::FrameStats s = scene.render(pose, true, 45.0, two_px);
+    const double ms = ms_since(t0);
+    if (s.slide_ms > 0) {
+      landing.push_back(ms);
+      tree.push_back(scene.last_slide().tree_ms);
+      vertices.push_back(scene.last_slide().vertices_ms);
+    } else if (pending || scene.slide_pending()) {
+      during.push_back(ms);
+    } else {
+      quiet.push_back(ms);
+    }
+  }
+  json out;
+  out["slides"] = landing.size();
+  if (landing.empty() || quiet.empty()) return out;
+  const double q = summarize(quiet).median;
+  out["quiet_frame_ms"] = to_json(summarize(quiet));
+  if (!during.empty()) {
+    out["during_frame_ms"] = to_json(summarize(during));
+    out["during_over_quiet_ms"] = summarize(during).median - q;
+  }
+  out["landing_frame_ms"] = landing;
+  out["landing_tree_ms"] = tree;
+  out["landing_vertices_ms"] = vertices;
+  out["landing_over_quiet_ms"] = summarize(landing).median - q;
+  return out;
+}
+
+}  // namespace
+
 json build_suite(const BenchConfig& c, const Terrain& terrain) {
   say(c, "build " + terrain.name + ": build and slide of a 1024-cell window");
   const io::Mosaic mosaic = io::Mosaic::open(terrain.dems);
@@ -497,6 +559,8 @@ json build_suite(const BenchConfig& c, const Terrain& terrain) {
   out["bytes_per_sample"] = json{{"nodes", static_cast<double>(m.nodes) / samples},
                              {"vertices", static_cast<double>(m.vertices) / samples},
                              {"total", static_cast<double>(m.total()) / samples}};
+  say(c, "build " + terrain.name + ": the viewer's frames through slides");
+  out["viewer_slides"] = viewer_slides(c, terrain, mosaic);
   return out;
 }
 

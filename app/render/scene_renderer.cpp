@@ -215,9 +215,11 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
 // vertices and the merge's scratch are gone, not held across the merge) is made here.
 void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const auto t0 = Clock::now();
-  // Every vertex changes: the renderer's copies (and their GPU buffers) are freed before the
-  // tree slides and merges again, so the merge's scratch does not come on top of them.
-  if (renderer_) renderer_->release_vertices();
+  // Every vertex changes. With volumes or objects the renderer's copies (and their GPU
+  // buffers) are freed before the tree slides and merges again, so the merge's scratch does not
+  // come on top of them; without, the tree merges nothing and keeps its vertex count, and the
+  // renderer writes the new vertices over the old ones (TerrainRenderer::replace_vertices).
+  if (renderer_ && (volumes_.size() > 0 || objects_.size() > 0)) renderer_->release_vertices();
   try {
     scene_->slide(std::move(p.window));  // merges the volumes' polygons again into the moved window
   } catch (...) {

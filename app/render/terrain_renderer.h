@@ -139,6 +139,11 @@ class TerrainRenderer {
   // the window). The vertex count may change (merged polygons come and go); the texture side
   // must be the constructor's, and the attribute counts must match the positions, else
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
+  // In the bsp order, with the same vertex count as held (a terrain-only window slid: its
+  // lattice and walls, no merged polygons), the arrays are written in place and only the
+  // positions and colours uploaded (OrderedPolyDataMapper::update_vertices), the texture
+  // coordinates only when they differ: no allocation, and no repacking by VTK. Otherwise
+  // (and after release_vertices()) every array is made and uploaded again.
   void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                         const ColorTexture& texture = {});
   // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only
@@ -164,8 +169,8 @@ class TerrainRenderer {
   void set_vertex_version(std::uint64_t v) { vertex_version_ = v; }
   // Frees every vertex array, the triangle lists and their buffers on the GPU (host memory
   // under Mesa's llvmpipe), keeping the texture. Call it before a slide or merge that will
-  // replace every vertex, so that the old vertices and the tree's merge scratch never hold
-  // memory at the same time. Until replace_vertices() and set_frame(), render() draws only
+  // replace every vertex with a merge's scratch (merged polygons), so that the old vertices
+  // and that scratch never hold memory at the same time. Until replace_vertices() and set_frame(), render() draws only
   // the background.
   void release_vertices();
 
@@ -213,6 +218,10 @@ class TerrainRenderer {
   // Positions and RGBA bytes (4 per vertex) of vertices first .. first + positions.size() into
   // the arrays, which must hold them; nothing is marked modified.
   void write_vertices(std::size_t first, std::span<const glm::vec3> positions, const void* rgba);
+  // replace_vertices() over the arrays held, when it can (see there); false when it cannot,
+  // with nothing changed.
+  bool replace_in_place(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+                        const ColorTexture& texture);
   // Translucent newcomers turn the ordered mapper's blending on (it stays on: what was
   // translucent still is).
   void blend_if_translucent(std::span<const glm::u8vec4> colors);

@@ -138,6 +138,48 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
   }
 }
 
+// A terrain-only slide keeps the vertex count: the renderer writes the new vertices over the
+// old ones and uploads them in place. The picture is the one a renderer made with the new
+// vertices draws.
+TEST(TerrainRenderer, VerticesReplacedInPlaceDrawWhatARendererMadeWithThemDraws) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  const TwoSquares s = two_squares(255);
+  const std::vector<scene::Rgba> yellow{{255, 255, 0, 255}};
+  scene::TerrainShading shading = s.shading;
+  shading.tcoords.assign(8, glm::vec2(-1.0f));  // vertex colours
+  TerrainRenderer renderer(s.positions, shading, two_squares_settings(scene::DrawOrder::kBsp), {1, yellow});
+  renderer.set_camera(s.camera, 100.0);
+  renderer.set_frame(frame_of(kFarThenNear));
+  renderer.render();
+  const test::Image before = test::image_of_rgb(renderer.rgb(), 64, 64);
+  ASSERT_EQ(before.at(32, 32), (test::Rgb8{255, 0, 0}));
+
+  // The near square moved right by half its side and textured, the far one recoloured.
+  std::vector<glm::vec3> moved = s.positions;
+  for (int v = 0; v < 4; ++v) moved[static_cast<std::size_t>(v)].x += 1.0f;
+  scene::TerrainShading recoloured = shading;
+  for (int v = 0; v < 4; ++v) recoloured.tcoords[static_cast<std::size_t>(v)] = glm::vec2(0.5f);
+  for (int v = 4; v < 8; ++v) recoloured.rgba[static_cast<std::size_t>(v)] = scene::Rgba{255, 255, 255, 255};
+  const std::vector<scene::Rgba> magenta{{255, 0, 255, 255}};
+  const void* storage = renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0);
+  renderer.replace_vertices(moved, recoloured, {1, magenta});
+  EXPECT_EQ(renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0), storage) << "written in place";
+  renderer.set_frame(frame_of(kFarThenNear));
+  renderer.render();
+  const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
+
+  TerrainRenderer fresh(moved, recoloured, two_squares_settings(scene::DrawOrder::kBsp), {1, magenta});
+  fresh.set_camera(s.camera, 100.0);
+  fresh.set_frame(frame_of(kFarThenNear));
+  fresh.render();
+  const test::Image expected = test::image_of_rgb(fresh.rgb(), 64, 64);
+  ASSERT_EQ(after.width, 64);
+  EXPECT_EQ(after.pixels, expected.pixels);
+  // Row 0 is the top of the picture; the near square now covers x from 0 to 2.
+  EXPECT_EQ(after.at(40, 32), (test::Rgb8{255, 0, 255})) << "the moved near square, with the new texel";
+  EXPECT_EQ(after.at(28, 32), (test::Rgb8{255, 255, 255})) << "the far square's new colour, uncovered";
+}
+
 // A textured floor (8 x 8 at z = 0, one yellow texel) and, over its left half, a run of 128
 // thin half-transparent blue triangles (merged pieces: vertex colours, texture coordinates -1)
 // at z = 1; then a textured square at z = 2 over the bottom-left quadrant. Drawn in that order,
