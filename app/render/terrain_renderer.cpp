@@ -556,13 +556,13 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
 }
 
 // replace_vertices() without allocating: the same count of vertices as held, written over the
-// old ones, positions and colours uploaded by the ordered mapper in one range, the texture
-// coordinates (a function of the lattice index, the same after a slide) only when they differ.
-// Measured on a terrain-only slide of the Utah mosaic (1024 cells, 1.06 M vertices, `terravol
-// bench --suites build`, the viewer's frames): the frame that lands the slide took 85-96 ms
-// against 19-25 ms for the frames around it; writing in place, instead of freeing the arrays
-// before the slide and making and uploading them again after it, 42-74 ms (the vertices 6-14
-// ms instead of 21-23, and the draw no longer repacks every array).
+// old ones; the colours uploaded by the ordered mapper in one range, the positions packed by
+// VTK (below), the texture coordinates (a function of the lattice index, the same after a
+// slide) only when they differ. Measured on terrain-only slides of the Utah mosaic (1024 cells,
+// 1.06 M vertices; `terravol bench --suites build`, the viewer's frames): the frame that lands
+// a slide took 85-96 ms against 19-25 ms for the frames around it when the arrays were freed
+// before the slide and made and uploaded again after it; 51-71 ms this way (the vertices 7-8 ms
+// instead of 21-23, and the draw no longer allocates and repacks every array).
 bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
@@ -580,9 +580,15 @@ bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, 
     texels->Modified();
     texture_image_->Modified();
   }
+  // The positions through VTK (only their array is marked modified, so only it is packed and
+  // uploaded again), so that they get the coordinate shift a fresh upload would give them and
+  // the picture does not depend on what was uploaded before (terravol fly --resume is byte for
+  // byte); the colours in place.
+  poly_->GetPoints()->GetData()->Modified();
+  poly_->GetPoints()->Modified();
   shade_ = shading.shade;
   point_rgba_ = shading.rgba;
-  ordered->update_vertices(0, n);
+  ordered->update_colors(0, n);
   choose_blending(*mapper_, shading.rgba, texture.rgba);
   poly_->Modified();
   return true;

@@ -140,10 +140,11 @@ class TerrainRenderer {
   // must be the constructor's, and the attribute counts must match the positions, else
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
   // In the bsp order, with the same vertex count as held (a terrain-only window slid: its
-  // lattice and walls, no merged polygons), the arrays are written in place and only the
-  // positions and colours uploaded (OrderedPolyDataMapper::update_vertices), the texture
-  // coordinates only when they differ: no allocation, and no repacking by VTK. Otherwise
-  // (and after release_vertices()) every array is made and uploaded again.
+  // lattice and walls, no merged polygons), the arrays are written in place: no allocation;
+  // the colours are uploaded in place (OrderedPolyDataMapper::update_colors), the positions
+  // packed again by VTK (so that the picture is the one a fresh upload gives), the texture
+  // coordinates only when they differ. Otherwise (and after release_vertices()) every array
+  // is made and uploaded again.
   void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                         const ColorTexture& texture = {});
   // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only
