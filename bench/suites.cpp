@@ -461,16 +461,16 @@ namespace {
 // The viewer's frames through window slides (issue 13, "viewer frame during a slide"): the
 // pipeline as `terravol view` runs it (Sliding::kAsynchronous: the moved window read and shaded
 // on a worker thread while the frames go on; at the first frame after that, the tree slid and
-// the renderer's vertices replaced on this thread), terrain only, the camera flying east 1000 m
-// above the ground, a twentieth of a coarsest cell per frame, until two slides have landed or
-// the mosaic's east edge is near. Each frame's wall time (prepare and draw, the viewer's loop
+// the renderer's vertices replaced on this thread), over `spec` (its window centred on its
+// camera), the camera flying east 1000 m above the ground from the window's centre, a twentieth
+// of a coarsest cell per frame, until two slides have landed or the mosaic's east edge is near. Each frame's wall time (prepare and draw, the viewer's loop
 // without its overlay) counts as quiet (no slide under way), during (the worker reading and
 // shading) or landing (the frame that slides the tree). No figures when no slide landed (the
 // window spans the mosaic east of its centre).
-json viewer_slides(const BenchConfig& c, const Terrain& terrain, const io::Mosaic& mosaic) {
+json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, const io::Mosaic& mosaic) {
   app::render::SceneOptions options = bench_scene_options();
   options.sliding = app::render::Sliding::kAsynchronous;
-  app::render::SceneRenderer scene(terrain_spec(terrain), plain_settings(c), options);
+  app::render::SceneRenderer scene(spec, plain_settings(c), options);
   const app::scene::WindowBounds b = scene.terrain().bounds();
   app::scene::CameraPose pose;
   pose.lat = 0.5 * (b.south + b.north);
@@ -560,7 +560,15 @@ json build_suite(const BenchConfig& c, const Terrain& terrain) {
                              {"vertices", static_cast<double>(m.vertices) / samples},
                              {"total", static_cast<double>(m.total()) / samples}};
   say(c, "build " + terrain.name + ": the viewer's frames through slides");
-  out["viewer_slides"] = viewer_slides(c, terrain, mosaic);
+  out["viewer_slides"] = viewer_slides(c, terrain_spec(terrain), mosaic);
+  // The same over the translucency suite's volumes (each slide merges them again).
+  if (const std::vector<volume::Transmitter> tx = benchmark_transmitters(terrain.name); !tx.empty()) {
+    say(c, "build " + terrain.name + ": the viewer's frames through slides, with the benchmark volumes");
+    const VolumeScene vs = three_volume_scene(terrain, tx, c.cache, c.log);
+    app::scene::SceneSpec spec = vs.spec;
+    spec.camera = terrain_spec(terrain, vs.lat, vs.lon).camera;
+    out["viewer_slides_volumes"] = viewer_slides(c, spec, mosaic);
+  }
   return out;
 }
 

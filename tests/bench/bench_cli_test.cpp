@@ -74,11 +74,16 @@ TEST(BenchCli, ASmallRunOnTheBundledDemWritesResultsReportAndPlots) {
   const auto& b = j["build"][0];
   EXPECT_GT(b["build_over_slide"].get<double>(), 0.0) << "reported (its size is a bench figure, not a test: it varies with load)";
   EXPECT_GT(b["bytes_per_sample"]["total"].get<double>(), 0.0);
+  // The bundled tile is barely wider than the window: the viewer's flight east lands no slide,
+  // and says so.
+  EXPECT_EQ(b["viewer_slides"]["slides"].get<std::size_t>(), 0u);
+  EXPECT_FALSE(b["viewer_slides"].contains("landing_frame_ms"));
 
   std::ifstream md(dir.path() / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("## 1. Terrain flythrough"), std::string::npos);
   EXPECT_NE(report.find("## 4. Build and slide"), std::string::npos);
+  EXPECT_NE(report.find("| N45E006 | 0 | no slide"), std::string::npos) << "the viewer's slides' row";
   for (const char* plot : {"plot-frame-time-N45E006.png", "plot-triangles-threshold.png", "plot-error-threshold.png"}) {
     EXPECT_TRUE(std::filesystem::exists(dir.path() / plot)) << plot;
     EXPECT_NE(report.find(plot), std::string::npos) << plot;
