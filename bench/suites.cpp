@@ -463,10 +463,11 @@ namespace {
 // on a worker thread while the frames go on; at the first frame after that, the tree slid and
 // the renderer's vertices replaced on this thread), over `spec` (its window centred on its
 // camera), the camera flying east 1000 m above the ground from the window's centre, a twentieth
-// of a coarsest cell per frame, until two slides have landed or the mosaic's east edge is near. Each frame's wall time (prepare and draw, the viewer's loop
-// without its overlay) counts as quiet (no slide under way), during (the worker reading and
-// shading) or landing (the frame that slides the tree). No figures when no slide landed (the
-// window spans the mosaic east of its centre).
+// of a coarsest cell per frame, until two slides have landed or the mosaic's east edge is near.
+// Each frame's wall time (prepare and draw, the viewer's loop without its overlay) counts as
+// quiet (no slide under way), during (the worker reading and shading) or landing (the frame
+// that slides the tree). No figures when no slide landed (the window spans the mosaic east of
+// its centre).
 json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, const io::Mosaic& mosaic) {
   app::render::SceneOptions options = bench_scene_options();
   options.sliding = app::render::Sliding::kAsynchronous;

@@ -171,8 +171,8 @@ class TerrainRenderer {
   // Frees every vertex array, the triangle lists and their buffers on the GPU (host memory
   // under Mesa's llvmpipe), keeping the texture. Call it before a slide or merge that will
   // replace every vertex with a merge's scratch (merged polygons), so that the old vertices
-  // and that scratch never hold memory at the same time. Until replace_vertices() and set_frame(), render() draws only
-  // the background.
+  // and that scratch never hold memory at the same time. Until replace_vertices() and
+  // set_frame(), render() draws only the background.
   void release_vertices();
 
   // The transmitter markers' names, drawn over the scene as billboard text (white, with a

@@ -139,8 +139,8 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
 }
 
 // A terrain-only slide keeps the vertex count: the renderer writes the new vertices over the
-// old ones and uploads them in place. The picture is the one a renderer made with the new
-// vertices draws.
+// old ones, in the same arrays. The picture is the one a renderer made with the new vertices
+// draws.
 TEST(TerrainRenderer, VerticesReplacedInPlaceDrawWhatARendererMadeWithThemDraws) {
   TERRAVOL_REQUIRE_DISPLAY();
   const TwoSquares s = two_squares(255);
