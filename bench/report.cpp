@@ -250,6 +250,11 @@ void build_section(std::ostringstream& md, const json& results) {
         "tree and vertex parts; then the same over the translucency suite's volumes, which each slide merges again.\n\n"
      << "| terrain | slides | quiet | during | landing | landing - quiet | tree | vertices |\n"
      << "|---|---|---|---|---|---|---|---|\n";
+  const auto list = [](const json& a) {  // a list of milliseconds, "52, 51"
+    std::string out;
+    for (const json& x : a) out += (out.empty() ? "" : ", ") + num(x.get<double>(), "%.0f");
+    return out;
+  };
   for (const json& b : results["build"])
     for (const char* key : {"viewer_slides", "viewer_slides_volumes"}) {
       if (!b.contains(key)) continue;
@@ -260,11 +265,6 @@ void build_section(std::ostringstream& md, const json& results) {
         md << "no slide (the window spans the mosaic east of its centre) | | | | | |\n";
         continue;
       }
-      const auto list = [](const json& a) {
-        std::string out;
-        for (const json& x : a) out += (out.empty() ? "" : ", ") + num(x.get<double>(), "%.0f");
-        return out;
-      };
       md << spread(v["quiet_frame_ms"], "%.1f") << " | "
          << (v.contains("during_frame_ms") ? spread(v["during_frame_ms"], "%.1f") : std::string("-")) << " | "
          << list(v["landing_frame_ms"]) << " | +" << num(v["landing_over_quiet_ms"].get<double>(), "%.0f") << " | "
