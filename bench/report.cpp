@@ -246,10 +246,12 @@ void build_section(std::ostringstream& md, const json& results) {
         "pipeline as `terravol view` runs it (the moved window read and shaded on a worker thread, the tree slid "
         "and the vertices replaced at the next frame), terrain only, flying east 1000 m above the ground, a "
         "twentieth of a coarsest cell per frame, until two slides land. Frame wall times in ms: quiet (no slide "
-        "under way), during (the worker reading and shading), and the frames that land a slide, with their "
-        "tree and vertex parts; then the same over the translucency suite's volumes, which each slide merges again.\n\n"
-     << "| terrain | slides | quiet | during | landing | landing - quiet | tree | vertices |\n"
-     << "|---|---|---|---|---|---|---|---|\n";
+        "under way), during (the worker reading, shading, copying the scene and sliding the copy), and the "
+        "frames that land a slide, with their tree part (swapping the slid copy in) and vertex part, and what "
+        "the copy and its slide took on the worker; then the same over the translucency suite's volumes, "
+        "which each slide merges again.\n\n"
+     << "| terrain | slides | quiet | during | landing | landing - quiet | tree | vertices | worker: copy, slide |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
   const auto list = [](const json& a) {  // a list of milliseconds, "52, 51"
     std::string out;
     for (const json& x : a) out += (out.empty() ? "" : ", ") + num(x.get<double>(), "%.0f");
@@ -262,13 +264,20 @@ void build_section(std::ostringstream& md, const json& results) {
       md << "| " << b["terrain"].get<std::string>() << (std::string(key) == "viewer_slides" ? "" : " with its benchmark volumes")
          << " | " << v["slides"].get<std::size_t>() << " | ";
       if (!v.contains("quiet_frame_ms")) {
-        md << "no slide (the window spans the mosaic east of its centre) | | | | | |\n";
+        md << "no slide (the window spans the mosaic east of its centre) | | | | | | |\n";
         continue;
       }
       md << spread(v["quiet_frame_ms"], "%.1f") << " | "
          << (v.contains("during_frame_ms") ? spread(v["during_frame_ms"], "%.1f") : std::string("-")) << " | "
          << list(v["landing_frame_ms"]) << " | +" << num(v["landing_over_quiet_ms"].get<double>(), "%.0f") << " | "
-         << list(v["landing_tree_ms"]) << " | " << list(v["landing_vertices_ms"]) << " |\n";
+         << list(v["landing_tree_ms"]) << " | " << list(v["landing_vertices_ms"]) << " | ";
+      if (v.contains("worker_copy_ms")) {
+        for (std::size_t k = 0; k < v["worker_copy_ms"].size(); ++k) {
+          md << (k ? "; " : "") << num(v["worker_copy_ms"][k].get<double>(), "%.0f") << ", "
+             << num(v["worker_tree_ms"][k].get<double>(), "%.0f");
+        }
+      }
+      md << " |\n";
     }
   md << "\n";
 }

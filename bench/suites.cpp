@@ -461,7 +461,8 @@ namespace {
 // The viewer's frames through window slides (issue 13, "viewer frame during a slide"): the
 // pipeline as `terravol view` runs it (Sliding::kAsynchronous: the moved window read and shaded
 // on a worker thread while the frames go on; at the first frame after that, the tree slid and
-// the renderer's vertices replaced on this thread), over `spec` (its window centred on its
+// the renderer's vertices replaced on this thread; the tree slid on the worker too, on a copy
+// of the scene, and swapped in), over `spec` (its window centred on its
 // camera), the camera flying east 1000 m above the ground from the window's centre, a twentieth
 // of a coarsest cell per frame, until two slides have landed or the mosaic's east edge is near.
 // Each frame's wall time (prepare and draw, the viewer's loop without its overlay) counts as
@@ -484,7 +485,7 @@ json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, cons
   const double east = g.x0 + (mosaic.cols() - 1) * g.dx - coarsest;
   const mrbsp::TraversalOptions two_px = lod(mrbsp::LodMetric::kError, 2.0);
   scene.render(pose, true, 45.0, two_px);  // warm-up
-  std::vector<double> quiet, during, landing, tree, vertices;
+  std::vector<double> quiet, during, landing, tree, vertices, copy, worker_tree;
   for (int f = 0; f < 1000 && landing.size() < 2 && pose.lon + coarsest / 20.0 < east; ++f) {
     pose.lon += coarsest / 20.0;
     const bool pending = scene.slide_pending();
@@ -495,6 +496,8 @@ json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, cons
       landing.push_back(ms);
       tree.push_back(scene.last_slide().tree_ms);
       vertices.push_back(scene.last_slide().vertices_ms);
+      copy.push_back(scene.last_slide().copy_ms);
+      worker_tree.push_back(scene.last_slide().worker_tree_ms);
     } else if (pending || scene.slide_pending()) {
       during.push_back(ms);
     } else {
@@ -513,6 +516,8 @@ json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, cons
   out["landing_frame_ms"] = landing;
   out["landing_tree_ms"] = tree;
   out["landing_vertices_ms"] = vertices;
+  out["worker_copy_ms"] = copy;
+  out["worker_tree_ms"] = worker_tree;
   out["landing_over_quiet_ms"] = summarize(landing).median - q;
   return out;
 }

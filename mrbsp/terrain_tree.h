@@ -228,6 +228,10 @@ class TerrainTree {
   // n = 2^k; level levels-1 is the full-resolution grid, each coarser level halves the
   // samples per side). Throws std::invalid_argument for a bad window or level count.
   TerrainTree(const TerrainWindow& window, int levels);
+  // A deep copy: what the copy does afterwards (slide, merge, traverse) leaves `other` as it
+  // is (terravol view slides a copy on a worker thread while frames go on). It must not run
+  // while another thread changes `other`.
+  TerrainTree(const TerrainTree& other);
   ~TerrainTree();
   TerrainTree(TerrainTree&&) noexcept;
   TerrainTree& operator=(TerrainTree&&) noexcept;

@@ -86,6 +86,13 @@ struct StagedVertices {
 // global and lets `staged` go. Kept small: there is one per built slot (17,763 in the
 // benchmark scene).
 struct BspStore {
+  BspStore() = default;
+  BspStore(const BspStore& other);  // a deep copy: the staged vertices too
+  BspStore(BspStore&&) noexcept = default;
+  BspStore& operator=(const BspStore& other) { return *this = BspStore(other); }
+  BspStore& operator=(BspStore&&) noexcept = default;
+  ~BspStore() = default;
+
   std::vector<BspNode> nodes;
   std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
   glm::vec3 box_base{0.0f}, box_step{1.0f};  // the boxes' grid: the store's bounds in at most 65535 steps
@@ -219,6 +226,13 @@ struct SurfacePieces {
 // never drawn from inside the window), so until then `built` is false and `top` and `pending`
 // come from the pieces that arrived there.
 struct Slot {
+  Slot() = default;
+  Slot(const Slot& other);  // a deep copy: the store too
+  Slot(Slot&&) noexcept = default;
+  Slot& operator=(const Slot& other) { return *this = Slot(other); }
+  Slot& operator=(Slot&&) noexcept = default;
+  ~Slot() = default;
+
   SlotKey key = 0;
   bool built = false;
   std::size_t pending = 0;  // pieces arrived, while not built

@@ -211,10 +211,52 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
   return p;
 }
 
-// What prepare_slide left out (with kSynchronous: the shading, so that it is made after the old
-// vertices and the merge's scratch are gone, not held across the merge) is made here.
+void SceneRenderer::slide_copy(PreparedSlide& p) const {
+  const auto t0 = Clock::now();
+  {
+    const std::lock_guard<std::mutex> lock(scene_mutex_);
+    p.slid = std::make_unique<scene::TerrainScene>(*scene_);
+    p.edits = edits_;
+  }
+  const auto t1 = Clock::now();
+  p.copy_ms = ms_between(t0, t1);
+  p.slid->slide(scene::SceneWindow(p.window));  // a copy: p.window stays for finish_slide's other way
+  const mrbsp::TerrainTree& tree = p.slid->tree();
+  if (p.vertices.rgba.size() != tree.positions().size() && !p.lattice.rgba.empty()) {
+    p.vertices = scene::vertex_shading(p.lattice, tree.merged_base(), tree.merged_colors());
+  }
+  p.tree_ms = ms_since(t1);
+}
+
 void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const auto t0 = Clock::now();
+  if (p.slid && p.edits == edits_) {
+    // The tree slid on the worker, on a copy of the scene taken after the last edit: the same
+    // tree this thread's slide would make (TerrainTree's copy is deep). Swapped in; the old
+    // scene is freed on a worker (its small BSPs are tens of thousands of allocations).
+    std::swap(scene_, p.slid);
+    if (retired_.valid()) retired_.wait();
+    retired_ = std::async(std::launch::async, [old = std::move(p.slid)]() mutable {
+      old.reset();
+      return_freed_memory();
+    });
+    const double tree_ms = ms_since(t0);
+    lattice_ = std::move(p.lattice);
+    const auto t1 = Clock::now();
+    const mrbsp::TerrainTree& tree = scene_->tree();
+    if (renderer_) {
+      renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+      renderer_->set_vertex_version(tree.merged_version());
+    }
+    last_slide_ = {p.read_ms, p.shade_ms, tree_ms, ms_since(t1), p.copy_ms, p.tree_ms};
+    ++slides_;
+    return;
+  }
+  // Slid here (kSynchronous, or edited since the copy was taken). What prepare_slide left out
+  // (with kSynchronous: the shading, so that it is made after the old vertices and the merge's
+  // scratch are gone, not held across the merge) is made here.
+  p.slid.reset();
+  p.vertices = {};
   // Every vertex changes. With volumes or objects the renderer's copies (and their GPU
   // buffers) are freed before the tree slides and merges again, so the merge's scratch does not
   // come on top of them; without, the tree merges nothing and keeps its vertex count, and the
@@ -283,7 +325,9 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
+          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
+          slide_copy(p);
+          return p;
         });
       }
     }
@@ -297,6 +341,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   scene::require_near(mosaic_, pose.lat, pose.lon);
   FrameStats stats;
   slide(pose, stats);
+  const std::lock_guard<std::mutex> lock(scene_mutex_);  // the worker copies the scene between frames
 
   stats.ground_height = ground_height(pose.lat, pose.lon);
   stats.eye_height = eye_above(stats.ground_height, pose, agl);
@@ -340,6 +385,7 @@ FrameStats SceneRenderer::prepare(const scene::CameraPose& pose, bool agl, doubl
   objects_.update(*scene_, camera_, traversal);
   stats.objects_ms = ms_since(t0);
   stats.objects_merged = objects_.figures().remerged;
+  if (stats.objects_merged > 0) ++edits_;
   t0 = Clock::now();
   if (tiled_) {
     const int aa = tiled_->settings().aa;
@@ -397,7 +443,9 @@ std::unique_ptr<TerrainRenderer> SceneRenderer::make_renderer(const RenderSettin
 }
 
 const scene::MergeFigures& SceneRenderer::remerge() {
+  const std::lock_guard<std::mutex> lock(scene_mutex_);
   volumes_.merge_into(*scene_);
+  ++edits_;
   if (tiled_) {
     if (options_.legend) tiled_->set_legend(volumes_.legend());
     tiled_->set_labels(volumes_.marker_labels());
@@ -410,8 +458,9 @@ const scene::MergeFigures& SceneRenderer::remerge() {
 }
 
 mrbsp::MergeStats SceneRenderer::tidy() {
+  const std::lock_guard<std::mutex> lock(scene_mutex_);
   if (scene_->tree().merge_stats().worn_slots == 0) return scene_->tree().merge_stats();
-  const mrbsp::MergeStats stats = scene_->tidy();
+  const mrbsp::MergeStats stats = scene_->tidy();  // the image does not change: not an edit
   if (renderer_) sync_vertices(*renderer_);
   return stats;
 }
@@ -432,7 +481,9 @@ double SceneRenderer::set_path(const volume::Mesh& path) {
   const auto t0 = Clock::now();
   const std::uint32_t id = scene::kProfilePathId;
   const mrbsp::SurfaceInput input{path.vertices, path.colors, path.triangles};
+  const std::lock_guard<std::mutex> lock(scene_mutex_);
   scene_->set_surfaces(std::span(&id, 1), std::span(&input, 1));
+  ++edits_;
   if (renderer_) sync_vertices(*renderer_);
   return ms_since(t0);
 }

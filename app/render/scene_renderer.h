@@ -99,6 +99,10 @@ struct SlideFigures {
   double read_ms = 0;   // reading the moved window (kAsynchronous: on the worker thread)
   double shade_ms = 0;  // shading it (kAsynchronous: on the worker; kSynchronous: after the tree)
   double tree_ms = 0, vertices_ms = 0;  // sliding the tree (merging again), replacing the renderer's vertices
+  // kAsynchronous: copying the scene and sliding the copy, on the worker (both 0 when the tree
+  // slid on the calling thread: kSynchronous, or the scene was edited during the read ahead).
+  // tree_ms is then what swapping the slid copy in cost the calling thread.
+  double copy_ms = 0, worker_tree_ms = 0;
 };
 
 // What is under a pixel (SceneRenderer::pick).
@@ -240,8 +244,14 @@ class SceneRenderer {
   struct PreparedSlide {
     scene::SceneWindow window;
     scene::TerrainShading lattice;   // empty: made after the slide
-    scene::TerrainShading vertices;  // of a tree without merged polygons; empty: made after the slide
+    scene::TerrainShading vertices;  // of the tree slid (`slid`, or one without merged polygons); empty: made after the slide
     double read_ms = 0, shade_ms = 0;
+    // kAsynchronous: a copy of the scene slid to `window` on the worker (taken between two
+    // frames), and edits_ when it was taken. finish_slide() swaps it in unless the scene was
+    // edited since; else it slides the scene itself to `window`.
+    std::unique_ptr<scene::TerrainScene> slid;
+    std::uint64_t edits = 0;
+    double copy_ms = 0, tree_ms = 0;  // the copy and its slide, on the worker
   };
   void slide(const scene::CameraPose& pose, FrameStats& stats);
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
@@ -249,6 +259,9 @@ class SceneRenderer {
                                      const scene::WindowChoice& next, const io::SceneFrame& frame,
                                      const std::optional<scene::ShadingOptions>& shading,
                                      std::size_t terrain_vertices);
+  // On the worker, after prepare_slide(): the scene copied (under scene_mutex_) and slid to
+  // the prepared window, and the vertices' shading made for the slid tree.
+  void slide_copy(PreparedSlide& prepared) const;
   void finish_slide(PreparedSlide&& prepared);
 
   io::Mosaic mosaic_;
@@ -274,6 +287,14 @@ class SceneRenderer {
   int slides_ = 0;
   SlideFigures last_slide_;
   std::optional<std::string> slide_error_;
+  // The worker copies the scene (slide_copy) while this thread holds no lock: this thread holds
+  // it whenever it changes the scene (a frame's preparation, whose traversal builds low
+  // alternatives and whose objects may merge again; edits; tidying).
+  mutable std::mutex scene_mutex_;
+  // Changes to the merged surfaces (remerge, set_path, objects merged again), counted under
+  // scene_mutex_: a copy slid on the worker from before one is not swapped in.
+  std::uint64_t edits_ = 0;
+  std::future<void> retired_;  // the scene a swap replaced, freed on a worker
   std::future<PreparedSlide> pending_;  // declared last: waited for before anything it reads goes
 };
 

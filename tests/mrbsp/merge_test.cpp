@@ -370,6 +370,46 @@ TEST(Merge, ASlideByWholeCellsKeepsWhatStaysAndDrawsWhatAFreshMergeDraws) {
   }
 }
 
+// A copy is deep (terravol view slides a copy on a worker while frames go on): the copy slid
+// and traversed (building low alternatives on first use) holds and draws what the original
+// slid the same way does, and the original, left alone meanwhile, draws what it drew before.
+TEST(Merge, ACopySlidAndTraversedLeavesTheOriginalAsItWas) {
+  std::mt19937 rng(2026);
+  const test::SlidingTerrain terrain(5);
+  const Soup soup = soup_over_sliding_terrain(rng, 60);
+  TerrainTree original(terrain.window_at(0, 0).view(), 3);
+  original.merge(soup.v, soup.c, soup.t);
+  const Camera c = camera_at({800.0, -200.0, 900.0}, {0.1, 1.0, -0.6});
+  TraversalOptions o;
+  o.threshold_px = 3.0f;
+  Frame before, f;
+  original.traverse(c, o, before);
+  const std::vector<glm::vec3> positions = original.positions();
+  const std::vector<glm::u8vec4> colors = original.merged_colors();
+
+  TerrainTree copy(original);
+  TerrainTree reference(terrain.window_at(0, 0).view(), 3);
+  reference.merge(soup.v, soup.c, soup.t);
+  reference.traverse(c, o, f);
+  for (const auto& at : {std::array{8, 4}, std::array{4, 12}}) {
+    copy.slide(terrain.window_at(at[0], at[1]).view());
+    reference.slide(terrain.window_at(at[0], at[1]).view());
+    Frame fc, fr;
+    const Camera moved = camera_at({100.0 * at[0] + 800.0, 100.0 * at[1] - 200.0, 900.0}, {0.1, 1.0, -0.6});
+    copy.traverse(moved, o, fc);
+    reference.traverse(moved, o, fr);
+    EXPECT_EQ(fc.indices, fr.indices) << "at " << at[0] << ", " << at[1];
+    EXPECT_EQ(copy.positions(), reference.positions());
+    EXPECT_EQ(copy.merged_colors(), reference.merged_colors());
+    EXPECT_GT(drawn_merged_area(copy, fc), 0.0);
+  }
+  EXPECT_EQ(original.positions(), positions);
+  EXPECT_EQ(original.merged_colors(), colors);
+  original.traverse(c, o, f);
+  EXPECT_EQ(f.indices, before.indices);
+  EXPECT_EQ(order_violations(original, f, c.eye, 150, rng, true), 0);
+}
+
 // Sliding there and back again keeps no more than a tree built at the end holds: the pieces
 // and vertices of what left the window are dropped.
 TEST(Merge, SlidingThereAndBackAgainHoldsWhatAFreshTreeHolds) {

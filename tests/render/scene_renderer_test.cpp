@@ -114,7 +114,8 @@ TEST(SceneRenderer, AReadAheadSlideLandsAtALaterFrameAsTheSynchronousOneDoes) {
   ASSERT_TRUE(render_until_slid(async));
   EXPECT_FALSE(async.slide_pending());
   EXPECT_GT(async.last_slide().read_ms, 0.0);
-  EXPECT_GT(async.last_slide().tree_ms, 0.0);
+  EXPECT_GT(async.last_slide().worker_tree_ms, 0.0) << "the tree slid on the worker, on a copy of the scene";
+  EXPECT_EQ(sync.last_slide().worker_tree_ms, 0.0) << "the synchronous slide is made on the calling thread";
   sync.render(kNorth, true, 45.0, {});
   expect_same_slide(sync, async);
 }
@@ -139,6 +140,39 @@ TEST(SceneRenderer, BothSlidesMergeTheVolumesAgainIntoTheMovedWindow) {
   ASSERT_TRUE(render_until_slid(async));
   sync.render(kNorth, true, 45.0, {});
   EXPECT_GT(sync.last_frame().indices.size(), 0u);
+  EXPECT_EQ(sync.terrain().tree().merged_colors(), async.terrain().tree().merged_colors());
+  expect_same_slide(sync, async);
+}
+
+// The worker slides a copy of the scene; an edit that comes after the copy was taken is not in
+// it, so that copy is not swapped in: the edited scene itself slides when the frame lands.
+TEST(SceneRenderer, AnEditDuringTheReadAheadIsInTheSlidTree) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const auto vdb = dir.path() / "rf.vdb";
+  const auto r = test::run_terravol("rf --quiet --tx 45.55,6.5,30 --dem " + bundled_dem() +
+                                    " --radius-km 3 --heights 0:600:100 -o " + vdb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  scene::VolumeSpec v;
+  v.file = vdb;
+  v.isosurfaces = {volume::parse_isosurface("110")};
+  v.slices = {volume::parse_slice("agl=300")};
+  const volume::SliceSpec moved = volume::parse_slice("agl=250");
+  SceneRenderer sync(scene_spec({v}), small_settings(), options(Sliding::kSynchronous));
+  SceneRenderer async(scene_spec({v}), small_settings(), options(Sliding::kAsynchronous));
+  sync.volumes().set_slice(0, 0, moved);
+  sync.remerge();
+  ASSERT_EQ(sync.render(kNorth, true, 45.0, {}).slides, 1);
+  async.render(kNorth, true, 45.0, {});
+  ASSERT_TRUE(async.slide_pending());
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!async.slide_ready() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_TRUE(async.slide_ready()) << "the copy was slid on the worker";
+  async.volumes().set_slice(0, 0, moved);
+  async.remerge();
+  ASSERT_TRUE(render_until_slid(async));
+  EXPECT_EQ(async.last_slide().worker_tree_ms, 0.0) << "the copy predates the edit: the scene slid on this thread";
+  sync.render(kNorth, true, 45.0, {});
   EXPECT_EQ(sync.terrain().tree().merged_colors(), async.terrain().tree().merged_colors());
   expect_same_slide(sync, async);
 }
