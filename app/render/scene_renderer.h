@@ -8,6 +8,7 @@
 // same code.
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <future>
 #include <memory>
@@ -294,6 +295,11 @@ class SceneRenderer {
   // Changes to the merged surfaces (remerge, set_path, objects merged again), counted under
   // scene_mutex_: a copy slid on the worker from before one is not swapped in.
   std::uint64_t edits_ = 0;
+  // Frames whose preparation ended (the scene unlocked: the frame draws now); slide_copy waits
+  // for the next one.
+  mutable std::mutex prepared_mutex_;
+  mutable std::condition_variable frame_prepared_;
+  std::uint64_t frames_prepared_ = 0;
   std::future<void> retired_;  // the scene a swap replaced, freed on a worker
   std::future<PreparedSlide> pending_;  // declared last: waited for before anything it reads goes
 };
