@@ -229,7 +229,6 @@ void SceneRenderer::slide_copy(PreparedSlide& p) const {
   }
   const auto t1 = Clock::now();
   p.copy_ms = ms_between(t0, t1);
-
   p.slid->slide(scene::SceneWindow(p.window));  // a copy: p.window stays for finish_slide's other way
   const mrbsp::TerrainTree& tree = p.slid->tree();
   if (p.vertices.rgba.size() != tree.positions().size() && !p.lattice.rgba.empty()) {
