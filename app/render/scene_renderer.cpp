@@ -513,8 +513,13 @@ std::optional<Pick> SceneRenderer::pick(int x, int y) const {
   const glm::dvec3 eye = camera_.eye;
   volume::Mesh surfaces = volumes_.visible_mesh();
   volume::append(surfaces, objects_.visible_mesh());
+  double far = 0;
+  {
+    const std::lock_guard<std::mutex> lock(scene_mutex_);  // far_plane() updates the scene's cache
+    far = scene_->far_plane(eye);
+  }
   const std::optional<scene::PickPoint> p = scene::pick(scene::pixel_ray(camera_, x, y), scene_->frame(), ground, inside,
-                                                        surfaces, scene_->far_plane(eye));
+                                                        surfaces, far);
   if (!p) return std::nullopt;
   Pick out;
   out.point = *p;

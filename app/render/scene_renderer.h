@@ -288,9 +288,9 @@ class SceneRenderer {
   int slides_ = 0;
   SlideFigures last_slide_;
   std::optional<std::string> slide_error_;
-  // The worker copies the scene (slide_copy) while this thread holds no lock: this thread holds
-  // it whenever it changes the scene (a frame's preparation, whose traversal builds low
-  // alternatives and whose objects may merge again; edits; tidying).
+  // The worker copies the scene (slide_copy) under this lock; this thread holds it whenever it
+  // changes the scene (a frame's preparation, whose traversal builds low alternatives and whose
+  // objects may merge again; edits; tidying; a pick's far plane, which updates a cache).
   mutable std::mutex scene_mutex_;
   // Changes to the merged surfaces (remerge, set_path, objects merged again), counted under
   // scene_mutex_: a copy slid on the worker from before one is not swapped in.
