@@ -7,8 +7,8 @@
 // traversal sends them through the tree as it decided it for this frame, without changing it,
 // and keeps each piece in a bucket at the place of the tree's order where it belongs:
 //   - the window's boundary planes first, in the walk's chain (west, east, south, north: a box
-//     beyond two belongs to the first): what lies beyond is cut into that side's bands (and,
-//     south and north, level-0 columns) as the merge cuts pieces (merge.cpp, to_bands), each
+//     beyond two belongs to the first): what lies beyond is cut into that side's bands and
+//     their level-0 rows or columns as the merge cuts pieces (merge.cpp, to_bands), each
 //     part into its place's outside slot, or a bucket drawn where that slot would be;
 //   - at every cell the walk enters, the plane z = h of its separation height (an LOD cell's
 //     terrain zmax; a top cell's zmax or the top of its subtree's merged content, whichever is
@@ -234,10 +234,10 @@ void BoxScratch::to_outside(const TerrainTree::Impl& m, int side, const Part& p,
     if (fresh) outside_places_[static_cast<std::size_t>(side)].push_back({band, column, find(bucket_key)});
   };
   const auto to_columns = [&](int band, Part q) {
-    const int columns = side < 2 ? 1 : m.cells_at(0), s0 = m.cell_size(0);
+    const int columns = m.cells_at(0), s0 = m.cell_size(0);
     for (int column = 0; column + 1 < columns; ++column) {
-      Part west{}, east{};
-      const int c = cut(q, 0, m.xs[static_cast<std::size_t>((column + 1) * s0)], tol, west, east);
+      Part west{}, east{};  // south and north of the line for west and east's rows
+      const int c = cut(q, m.column_axis(side), m.column_lines(side)[static_cast<std::size_t>((column + 1) * s0)], tol, west, east);
       if (c < 0) {
         to_place(band, column, q);
         return;

@@ -791,19 +791,20 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       // Colour boxes beyond the side in places without a slot (BoxScratch::outside_places).
       const std::vector<BoxScratch::OutsideBoxes>* boxed = box_order ? &box_order->outside_places(side) : nullptr;
       if (slots.empty() && (boxed == nullptr || boxed->empty())) continue;
-      // Each place is a box: its band's slab across the side's axis, its column's along the
-      // other (south and north); sorted by the band's distance from the eye, then the column's.
-      const double eye_at = side < 2 ? e.x : e.y;
+      // Each place is a box: its band's slab across the side's axis, its column's (row's) along
+      // the other; sorted by the band's distance from the eye, then the column's. (The first and
+      // last rows of west and east reach beyond the window's south and north planes; the
+      // distance to the row's bounds within the window orders them the same among parallel
+      // slabs.)
+      const double eye_at = side < 2 ? e.x : e.y, eye_across = side < 2 ? e.y : e.x;
+      const std::vector<double>& lines = m.column_lines(side);
+      const int s0 = m.cell_size(0);
       places.clear();
       const auto place = [&](int band, int column, std::uint64_t item) {
         const double a = m.band_plane(side, band);
         const double b = band + 1 < kBands ? m.band_plane(side, band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
-        double column_distance = 0.0;
-        if (side >= 2) {
-          const int s0 = m.cell_size(0);
-          const double x0 = m.xs[static_cast<std::size_t>(column * s0)], x1 = m.xs[static_cast<std::size_t>((column + 1) * s0)];
-          column_distance = e.x < x0 ? x0 - e.x : e.x > x1 ? e.x - x1 : 0.0;
-        }
+        const double x0 = lines[static_cast<std::size_t>(column * s0)], x1 = lines[static_cast<std::size_t>((column + 1) * s0)];
+        const double column_distance = eye_across < x0 ? x0 - eye_across : eye_across > x1 ? eye_across - x1 : 0.0;
         const double lo = std::min(a, b), hi = std::max(a, b);
         const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
         places.push_back({band_distance, column_distance, item});
