@@ -120,17 +120,24 @@ TEST(SceneRenderer, AReadAheadSlideLandsAtALaterFrameAsTheSynchronousOneDoes) {
   expect_same_slide(sync, async);
 }
 
-TEST(SceneRenderer, BothSlidesMergeTheVolumesAgainIntoTheMovedWindow) {
-  TERRAVOL_REQUIRE_DISPLAY();
-  test::TempDir dir;
+// A 3 km RF volume over the bundled tile that the slide north keeps in the window (written into
+// `dir`), with an isosurface at 110 dB and a slice 300 m above the ground.
+scene::VolumeSpec volume_near_the_slide(const test::TempDir& dir) {
   const auto vdb = dir.path() / "rf.vdb";
   const auto r = test::run_terravol("rf --quiet --tx 45.55,6.5,30 --dem " + bundled_dem() +
                                     " --radius-km 3 --heights 0:600:100 -o " + vdb.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.status, 0) << r.err;
   scene::VolumeSpec v;
   v.file = vdb;
   v.isosurfaces = {volume::parse_isosurface("110")};
   v.slices = {volume::parse_slice("agl=300")};
+  return v;
+}
+
+TEST(SceneRenderer, BothSlidesMergeTheVolumesAgainIntoTheMovedWindow) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  test::TempDir dir;
+  const scene::VolumeSpec v = volume_near_the_slide(dir);
   SceneRenderer sync(scene_spec({v}), small_settings(), options(Sliding::kSynchronous));
   SceneRenderer async(scene_spec({v}), small_settings(), options(Sliding::kAsynchronous));
   const std::size_t merged = sync.merge_figures().tree_triangles;
@@ -149,14 +156,7 @@ TEST(SceneRenderer, BothSlidesMergeTheVolumesAgainIntoTheMovedWindow) {
 TEST(SceneRenderer, AnEditDuringTheReadAheadIsInTheSlidTree) {
   TERRAVOL_REQUIRE_DISPLAY();
   test::TempDir dir;
-  const auto vdb = dir.path() / "rf.vdb";
-  const auto r = test::run_terravol("rf --quiet --tx 45.55,6.5,30 --dem " + bundled_dem() +
-                                    " --radius-km 3 --heights 0:600:100 -o " + vdb.string());
-  ASSERT_EQ(r.status, 0) << r.err;
-  scene::VolumeSpec v;
-  v.file = vdb;
-  v.isosurfaces = {volume::parse_isosurface("110")};
-  v.slices = {volume::parse_slice("agl=300")};
+  const scene::VolumeSpec v = volume_near_the_slide(dir);
   const volume::SliceSpec moved = volume::parse_slice("agl=250");
   SceneRenderer sync(scene_spec({v}), small_settings(), options(Sliding::kSynchronous));
   SceneRenderer async(scene_spec({v}), small_settings(), options(Sliding::kAsynchronous));
