@@ -237,7 +237,8 @@ void BoxScratch::to_outside(const TerrainTree::Impl& m, int side, const Part& p,
     const int columns = m.cells_at(0), s0 = m.cell_size(0);
     for (int column = 0; column + 1 < columns; ++column) {
       Part west{}, east{};  // south and north of the line for west and east's rows
-      const int c = cut(q, m.column_axis(side), m.column_lines(side)[static_cast<std::size_t>((column + 1) * s0)], tol, west, east);
+      const double line = m.column_lines(side)[static_cast<std::size_t>((column + 1) * s0)];
+      const int c = cut(q, m.column_axis(side), line, tol, west, east);
       if (c < 0) {
         to_place(band, column, q);
         return;

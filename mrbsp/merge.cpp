@@ -1604,7 +1604,9 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     merge_stats.dropped_pieces += store->dropped;
     staged += store->staged_count();
     live += store->refs.size();
-    if (store->staged || store->staged_refs < store->refs.size()) to_flush.push_back(slot.store.get());
+    if (store->staged || store->staged_refs < store->refs.size()) {
+      to_flush.push_back(slot.store.get());
+    }
   }
   positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
   merged_colors.reserve(merged_colors.size() + staged);
@@ -1745,7 +1747,8 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   // Each slot apart (in parallel: the references of every kept store are read and written),
   // then the kept ones gathered in order.
   std::vector<std::optional<SlotKey>> keys(slots.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
+  const tbb::blocked_range<std::size_t> all(0, slots.size(), 512);
+  tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t k = range.begin(); k != range.end(); ++k) {
       keys[k] = renamed(slots[k].key);
       if (!keys[k] || !slots[k].store) continue;

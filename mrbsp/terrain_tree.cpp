@@ -253,7 +253,11 @@ BspStore::BspStore(const BspStore& o)
       fresh_pieces(o.fresh_pieces) {}
 
 Slot::Slot(const Slot& o)
-    : key(o.key), built(o.built), pending(o.pending), top(o.top), store(o.store ? std::make_unique<BspStore>(*o.store) : nullptr) {}
+    : key(o.key),
+      built(o.built),
+      pending(o.pending),
+      top(o.top),
+      store(o.store ? std::make_unique<BspStore>(*o.store) : nullptr) {}
 
 std::size_t BspStore::bytes() const {
   std::size_t n = held(nodes) + held(boxes) + held(polys) + held(refs);
@@ -803,8 +807,10 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       const auto place = [&](int band, int column, std::uint64_t item) {
         const double a = m.band_plane(side, band);
         const double b = band + 1 < kBands ? m.band_plane(side, band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
-        const double x0 = lines[static_cast<std::size_t>(column * s0)], x1 = lines[static_cast<std::size_t>((column + 1) * s0)];
-        const double column_distance = eye_across < x0 ? x0 - eye_across : eye_across > x1 ? eye_across - x1 : 0.0;
+        const double x0 = lines[static_cast<std::size_t>(column * s0)];
+        const double x1 = lines[static_cast<std::size_t>((column + 1) * s0)];
+        const double column_distance =
+            eye_across < x0 ? x0 - eye_across : eye_across > x1 ? eye_across - x1 : 0.0;
         const double lo = std::min(a, b), hi = std::max(a, b);
         const double band_distance = eye_at < lo ? lo - eye_at : eye_at > hi ? eye_at - hi : 0.0;
         places.push_back({band_distance, column_distance, item});

@@ -214,12 +214,13 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
 void SceneRenderer::slide_copy(PreparedSlide& p) const {
   // The copy waits for a frame's preparation to end, so that it is taken while that frame
   // draws: taken whenever the read ended, it came at the next preparation as often as not,
-  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy takes 43-75).
+  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy takes 43-104).
   // Not for long: with no frames coming (the viewer idle) it is taken anyway.
   {
     std::unique_lock<std::mutex> wait(prepared_mutex_);
     const std::uint64_t seen = frames_prepared_;
-    frame_prepared_.wait_for(wait, std::chrono::milliseconds(100), [&] { return frames_prepared_ != seen; });
+    frame_prepared_.wait_for(wait, std::chrono::milliseconds(100),
+                             [&] { return frames_prepared_ != seen; });
   }
   const auto t0 = Clock::now();
   {
@@ -229,7 +230,8 @@ void SceneRenderer::slide_copy(PreparedSlide& p) const {
   }
   const auto t1 = Clock::now();
   p.copy_ms = ms_between(t0, t1);
-  p.slid->slide(scene::SceneWindow(p.window));  // a copy: p.window stays for finish_slide's other way
+  // A copy of the window: p.window stays for finish_slide's other way.
+  p.slid->slide(scene::SceneWindow(p.window));
   const mrbsp::TerrainTree& tree = p.slid->tree();
   if (p.vertices.rgba.size() != tree.positions().size() && !p.lattice.rgba.empty()) {
     p.vertices = scene::vertex_shading(p.lattice, tree.merged_base(), tree.merged_colors());
@@ -254,7 +256,8 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     const auto t1 = Clock::now();
     const mrbsp::TerrainTree& tree = scene_->tree();
     if (renderer_) {
-      renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+      renderer_->replace_vertices(tree.positions(), p.vertices,
+                                  ColorTexture{scene_->cells() + 1, lattice_.rgba});
       renderer_->set_vertex_version(tree.merged_version());
     }
     last_slide_ = {p.read_ms, p.shade_ms, tree_ms, ms_since(t1), p.copy_ms, p.tree_ms};
@@ -334,7 +337,8 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
+          PreparedSlide p =
+              prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
           slide_copy(p);
           return p;
         });

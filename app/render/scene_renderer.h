@@ -245,7 +245,8 @@ class SceneRenderer {
   struct PreparedSlide {
     scene::SceneWindow window;
     scene::TerrainShading lattice;   // empty: made after the slide
-    scene::TerrainShading vertices;  // of the tree slid (`slid`, or one without merged polygons); empty: made after the slide
+    // Of the tree slid (`slid`, or one without merged polygons); empty: made after the slide.
+    scene::TerrainShading vertices;
     double read_ms = 0, shade_ms = 0;
     // kAsynchronous: a copy of the scene slid to `window` on the worker (taken between two
     // frames), and edits_ when it was taken. finish_slide() swaps it in unless the scene was

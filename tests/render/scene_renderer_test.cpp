@@ -166,7 +166,9 @@ TEST(SceneRenderer, AnEditDuringTheReadAheadIsInTheSlidTree) {
   async.render(kNorth, true, 45.0, {});
   ASSERT_TRUE(async.slide_pending());
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!async.slide_ready() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (!async.slide_ready() && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   ASSERT_TRUE(async.slide_ready()) << "the copy was slid on the worker";
   async.volumes().set_slice(0, 0, moved);
   async.remerge();
