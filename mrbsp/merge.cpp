@@ -1608,9 +1608,15 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
       to_flush.push_back(slot.store.get());
     }
   }
-  positions.reserve(positions.size() + staged);  // exactly: no doubling slack kept
-  merged_colors.reserve(merged_colors.size() + staged);
-  if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged);
+  // Room for the staged vertices and, when the vertices must move anyway, a sixteenth of the
+  // merged ones more (not doubled: the memory stays near what the merge needs). Reserved
+  // exactly, every slide and edit moved all of them (1.5 M positions, 18 MB, on the benchmark's
+  // Utah scene): 3-12 ms of a slide's merge, none after the first with the sixteenth.
+  const std::size_t slack =
+      positions.capacity() < positions.size() + staged ? (positions.size() - merged_base()) / 16 : 0;
+  positions.reserve(positions.size() + staged + slack);
+  merged_colors.reserve(merged_colors.size() + staged + slack);
+  if (has_tcoords) merged_tcoords.reserve(merged_tcoords.size() + staged + slack);
   for (BspStore* store : to_flush) flush(*store);  // in the slots' order
   if (dead_refs > live) compact();
   make_content();

@@ -326,8 +326,8 @@ class TerrainTree {
   // levels(): about 170 bytes per lattice sample for 3 or more levels (2.3 nodes of 56 bytes
   // and three 12-byte positions per sample), so about 4x when the window's side doubles, and
   // unchanged by slide(). merged is 0 before any merge() and after merging nothing; merge()
-  // and slide() leave its containers at the size the current merge needs, so it follows the
-  // current merge, not the largest one so far.
+  // and slide() leave its containers at the size the current merge needs (the merged vertices'
+  // within a sixteenth more), so it follows the current merge, not the largest one so far.
   MemoryStats memory() const;
 
   struct Impl;  // defined in mrbsp/tree_impl.h, private to mrbsp/
