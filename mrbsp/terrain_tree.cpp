@@ -235,30 +235,6 @@ std::size_t held(const std::vector<T>& v) {
 
 }  // namespace
 
-BspStore::BspStore(const BspStore& o)
-    : nodes(o.nodes),
-      boxes(o.boxes),
-      box_base(o.box_base),
-      box_step(o.box_step),
-      polys(o.polys),
-      refs(o.refs),
-      staged(o.staged ? std::make_unique<StagedVertices>(*o.staged) : nullptr),
-      staged_refs(o.staged_refs),
-      root(o.root),
-      pieces(o.pieces),
-      dropped(o.dropped),
-      top(o.top),
-      arrivals(o.arrivals),
-      fresh_arrivals(o.fresh_arrivals),
-      fresh_pieces(o.fresh_pieces) {}
-
-Slot::Slot(const Slot& o)
-    : key(o.key),
-      built(o.built),
-      pending(o.pending),
-      top(o.top),
-      store(o.store ? std::make_unique<BspStore>(*o.store) : nullptr) {}
-
 std::size_t BspStore::bytes() const {
   std::size_t n = held(nodes) + held(boxes) + held(polys) + held(refs);
   if (staged) n += sizeof(StagedVertices) + held(staged->positions) + held(staged->colors) + held(staged->tcoords);

@@ -72,6 +72,20 @@ struct NodeBox {
 };
 inline constexpr std::int32_t kDropSide = -2;
 
+// A std::unique_ptr whose copy copies what it points to, so that the structures holding one
+// copy deeply with their implicit copy (TerrainTree's copy: terravol view slides a copy on a
+// worker thread).
+template <class T>
+struct DeepPtr : std::unique_ptr<T> {
+  DeepPtr() = default;
+  DeepPtr(std::unique_ptr<T>&& p) noexcept : std::unique_ptr<T>(std::move(p)) {}  // implicit: p = make_unique
+  DeepPtr(const DeepPtr& o) : std::unique_ptr<T>(o ? std::make_unique<T>(*o) : nullptr) {}
+  DeepPtr(DeepPtr&&) noexcept = default;
+  DeepPtr& operator=(const DeepPtr& o) { return *this = DeepPtr(o); }
+  DeepPtr& operator=(DeepPtr&&) noexcept = default;
+  ~DeepPtr() = default;
+};
+
 // Vertices made while a small BSP is built, before Impl::flush() moves them into the tree's
 // merged vertices.
 struct StagedVertices {
@@ -86,19 +100,12 @@ struct StagedVertices {
 // global and lets `staged` go. Kept small: there is one per built slot (17,763 in the
 // benchmark scene).
 struct BspStore {
-  BspStore() = default;
-  BspStore(const BspStore& other);  // a deep copy: the staged vertices too
-  BspStore(BspStore&&) noexcept = default;
-  BspStore& operator=(const BspStore& other) { return *this = BspStore(other); }
-  BspStore& operator=(BspStore&&) noexcept = default;
-  ~BspStore() = default;
-
   std::vector<BspNode> nodes;
   std::vector<NodeBox> boxes;  // one per node (bound_nodes()), kept apart: read only near the frustum's sides
   glm::vec3 box_base{0.0f}, box_step{1.0f};  // the boxes' grid: the store's bounds in at most 65535 steps
   std::vector<Polygon> polys;
   std::vector<std::uint32_t> refs;
-  std::unique_ptr<StagedVertices> staged;  // null when nothing is staged
+  DeepPtr<StagedVertices> staged;  // null when nothing is staged
   std::uint32_t staged_refs = 0;
   std::int32_t root = -1;
   std::uint32_t pieces = 0;   // merged polygons (terrain triangles not counted)
@@ -229,20 +236,13 @@ struct SurfacePieces {
 // never drawn from inside the window), so until then `built` is false and `top` and `pending`
 // come from the pieces that arrived there.
 struct Slot {
-  Slot() = default;
-  Slot(const Slot& other);  // a deep copy: the store too
-  Slot(Slot&&) noexcept = default;
-  Slot& operator=(const Slot& other) { return *this = Slot(other); }
-  Slot& operator=(Slot&&) noexcept = default;
-  ~Slot() = default;
-
   SlotKey key = 0;
   bool built = false;
   std::size_t pending = 0;  // pieces arrived, while not built
   float top = 0.0f;         // highest vertex of the pieces arrived (the built store's is lower or equal)
   // Held apart (about 200 bytes of empty containers): most slots are low alternatives that are
   // never built. Not null when built.
-  std::unique_ptr<BspStore> store;
+  DeepPtr<BspStore> store;
   // The store's, or 0 when there is none.
   std::size_t refs() const { return store ? store->refs.size() : 0; }
 };
