@@ -460,15 +460,15 @@ namespace {
 
 // The viewer's frames through window slides (issue 13, "viewer frame during a slide"): the
 // pipeline as `terravol view` runs it (Sliding::kAsynchronous: the moved window read and shaded
-// on a worker thread while the frames go on; at the first frame after that, the tree slid and
-// the renderer's vertices replaced on this thread; the tree slid on the worker too, on a copy
-// of the scene, and swapped in), over `spec` (its window centred on its
-// camera), the camera flying east 1000 m above the ground from the window's centre, a twentieth
-// of a coarsest cell per frame, until two slides have landed or the mosaic's east edge is near.
-// Each frame's wall time (prepare and draw, the viewer's loop without its overlay) counts as
-// quiet (no slide under way), during (the worker reading and shading) or landing (the frame
-// that slides the tree). No figures when no slide landed (the window spans the mosaic east of
-// its centre).
+// on a worker thread while the frames go on, and the tree slid there on a copy of the scene;
+// at the first frame after that, the slid copy swapped in and the renderer's vertices replaced
+// on this thread), over `spec` (its window centred on its camera), the camera flying east
+// 1000 m above the ground from the window's centre, a twentieth of a coarsest cell per frame,
+// until two slides have landed or the mosaic's east edge is near. Each frame's wall time
+// (prepare and draw, the viewer's loop without its overlay) counts as quiet (no slide under
+// way), during (the worker reading, shading, copying and sliding) or landing (the frame that
+// swaps the slid tree in). No figures when no slide landed (the window spans the mosaic east
+// of its centre).
 json viewer_slides(const BenchConfig& c, const app::scene::SceneSpec& spec, const io::Mosaic& mosaic) {
   app::render::SceneOptions options = bench_scene_options();
   options.sliding = app::render::Sliding::kAsynchronous;
