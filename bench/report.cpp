@@ -243,8 +243,8 @@ void build_section(std::ostringstream& md, const json& results) {
        << num(b["bytes_per_sample"]["vertices"].get<double>(), "%.0f") << ") |\n";
   }
   md << "\nThe viewer's frames through slides (issue 13: at most 5 ms more than the frames around them): the "
-        "pipeline as `terravol view` runs it (the moved window read and shaded on a worker thread, the tree slid "
-        "and the vertices replaced at the next frame), terrain only, flying east 1000 m above the ground, a "
+        "pipeline as `terravol view` runs it (the moved window read and shaded and the tree slid on a copy of "
+        "the scene, on a worker thread; the copy swapped in and the vertices replaced at the next frame), terrain only, flying east 1000 m above the ground, a "
         "twentieth of a coarsest cell per frame, until two slides land. Frame wall times in ms: quiet (no slide "
         "under way), during (the worker reading, shading, copying the scene and sliding the copy), and the "
         "frames that land a slide, with their tree part (swapping the slid copy in) and vertex part, and what "
