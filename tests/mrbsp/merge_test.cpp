@@ -402,6 +402,7 @@ TEST(Merge, ACopySlidAndTraversedLeavesTheOriginalAsItWas) {
     EXPECT_EQ(copy.positions(), reference.positions());
     EXPECT_EQ(copy.merged_colors(), reference.merged_colors());
     EXPECT_GT(drawn_merged_area(copy, fc), 0.0);
+    EXPECT_EQ(order_violations(copy, fc, moved.eye, 150, rng, true), 0) << "against the brute-force ray order";
   }
   EXPECT_EQ(original.positions(), positions);
   EXPECT_EQ(original.merged_colors(), colors);
