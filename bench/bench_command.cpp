@@ -175,9 +175,17 @@ void run_bench(const BenchOptions& o, const std::string& command) {
     for (const Terrain& t : real) results["terrain"].push_back(terrain_suite(c, t));
   if (suites.count("lowalt"))
     for (const Terrain& t : real) results["lowalt"].push_back(lowalt_suite(c, t));
-  if (suites.count("translucency"))
+  if (suites.count("translucency")) {
     for (std::size_t k = 0; k < transmitters.size(); ++k)
       results["translucency"].push_back(translucency_suite(c, real[k], transmitters[k]));
+    const std::filesystem::path bundled = "data/dem/N45E006.hgt", hydrogen = data / "volume" / "hydrogen.vtk";
+    if (!std::filesystem::exists(bundled) || !std::filesystem::exists(hydrogen)) {
+      c.log(bundled.string() + " or " + hydrogen.string() + " not found: the hydrogen.vtk figure is skipped");
+    } else {
+      c.log("translucency: hydrogen.vtk over the bundled DEM, five cameras");
+      results["hydrogen"] = hydrogen_pieces(c, bundled, hydrogen);
+    }
+  }
   if (suites.count("exactness"))
     for (const Terrain& t : real) {
       if (std::find(exact.begin(), exact.end(), &t) != exact.end()) {

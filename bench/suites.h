@@ -47,6 +47,14 @@ nlohmann::json terrain_suite(const BenchConfig& config, const Terrain& terrain);
 nlohmann::json translucency_suite(const BenchConfig& config, const Terrain& terrain,
                                   const std::vector<volume::Transmitter>& transmitters);
 
+// Part of 2 (issue 11's closed surface): hydrogen.vtk's isosurface at 0.02 (`volume`, 64 m
+// across, --volume-frame enu:45.5,6.5,1900) over the bundled DEM (`dem`, N45E006) from five
+// cameras around it, each with its own window, as `terravol render --stats` draws one frame:
+// the pieces the tree stores per input triangle after that frame (low alternatives included)
+// and the merge time, summarised over the cameras. Throws what SceneRenderer throws.
+nlohmann::json hydrogen_pieces(const BenchConfig& config, const std::filesystem::path& dem,
+                               const std::filesystem::path& volume);
+
 // 3. Scaling: one view (2500 m above the window's centre, pitch -20) of each terrain in its
 // largest window (at most 4096 cells): MRBSP at 1 px and plain VTK at full resolution.
 nlohmann::json scaling_suite(const BenchConfig& config, const std::vector<Terrain>& terrains);
