@@ -93,7 +93,7 @@ void OrderedPolyDataMapper::BuildBufferObjects(vtkRenderer* ren, vtkActor* act) 
   vtkPolyData* poly = this->CurrentInput;
   if (poly == nullptr || poly->GetPoints() == nullptr) return;
   // Positions: as VTK packs them (3 floats a vertex, shifted and scaled when it does so).
-  vtkOpenGLVertexBufferObject* vbo = update_positions_ ? this->VBOs->GetVBO("vertexMC") : nullptr;
+  vtkOpenGLVertexBufferObject* vbo = this->VBOs->GetVBO("vertexMC");
   if (vbo != nullptr) {
     auto* points = static_cast<const float*>(poly->GetPoints()->GetData()->GetVoidPointer(0));
     const unsigned stride = vbo->GetStride();

@@ -57,14 +57,6 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
   // Ranges given before one draw are joined (the smallest range holding them all).
   void update_vertices(std::size_t first, std::size_t count) {
     if (count == 0) return;
-    update_positions_ = true;
-    join_update(first, count);
-  }
-  // The same for the colours alone (the positions' array marked modified, so that VTK packs
-  // and uploads it); update_vertices() before the same draw writes both.
-  void update_colors(std::size_t first, std::size_t count) {
-    if (count == 0) return;
-    if (update_count_ == 0) update_positions_ = false;
     join_update(first, count);
   }
 
@@ -101,7 +93,6 @@ class OrderedPolyDataMapper : public vtkOpenGLPolyDataMapper {
  private:
   bool blending_ = true;
   std::size_t update_first_ = 0, update_count_ = 0;
-  bool update_positions_ = true;  // with the colours (update_vertices), or the colours alone
   void join_update(std::size_t first, std::size_t count) {
     if (update_count_ == 0) {
       update_first_ = first;

@@ -12,6 +12,8 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkProperty.h>
 #include <vtkProperty2D.h>
 #include <vtkRenderWindow.h>
@@ -68,6 +70,23 @@ void choose_blending(vtkPolyDataMapper& mapper, std::span<const scene::Rgba> ver
   const auto opaque = [](const scene::Rgba& c) { return c[3] == 255; };
   ordered->set_blending(!std::all_of(vertex_rgba.begin(), vertex_rgba.end(), opaque) ||
                         !std::all_of(texels.begin(), texels.end(), opaque));
+}
+
+// The positions go to the GPU as they are: scene-frame floats, no coordinate shift or scale.
+// VTK's default shifts them by the centre of their bounds and scales them by their range,
+// values that change with every slide of the window, so that writing new positions in place
+// (glBufferSubData, OrderedPolyDataMapper::update_vertices) with the last upload's shift gave
+// pictures a few bytes off a fresh upload's; VTK then had to pack and upload every position
+// again at each slide (about 15 ms of the frame that lands one, 1.06 M vertices over Utah).
+// Unshifted, a fresh upload and one in place are the same floats. What it costs is precision:
+// the tree's positions are floats in the scene frame already (half a unit in the last place
+// is 4 mm 100 km from its origin), and the vertex transform in floats adds an error of the
+// same order (float epsilon times the eye's distance from the origin), where VTK's shift
+// made it about the eye's distance from the window's centre.
+void unshifted(vtkPolyDataMapper& mapper) {
+  if (auto* gl = vtkOpenGLPolyDataMapper::SafeDownCast(&mapper)) {
+    gl->SetVBOShiftScaleMethod(vtkOpenGLVertexBufferObject::DISABLE_SHIFT_SCALE);
+  }
 }
 
 // One X connection for the whole process, handed to every VTK window. Xvfb (as xvfb-run
@@ -165,6 +184,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
     mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
   }
   mapper_->SetInputData(poly_);
+  unshifted(*mapper_);
   choose_blending(*mapper_, shading.rgba, texture.rgba);
   mapper_->SetColorModeToDirectScalars();
   mapper_->InterpolateScalarsBeforeMappingOff();
@@ -194,6 +214,7 @@ TerrainRenderer::TerrainRenderer(const std::vector<glm::vec3>& positions, const 
       merged_mapper_ = vtkSmartPointer<vtkPolyDataMapper>::New();
       merged_mapper_->SetInputData(merged_poly_);
     }
+    unshifted(*merged_mapper_);
     merged_mapper_->SetColorModeToDirectScalars();
     merged_mapper_->InterpolateScalarsBeforeMappingOff();
     merged_mapper_->ScalarVisibilityOn();
@@ -549,25 +570,30 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   }
   shade_ = shading.shade;
   point_rgba_ = shading.rgba;
-  if (tail_ > 0) reserve_tail(tail_);  // the frames' own vertices after the new ones
+  // Room after the new vertices: the frames' own (colour-box faces), the pieces later edits
+  // and traversals append, and the next slide's vertices when they outnumber these (written
+  // in place then, replace_in_place); a sixteenth, as append_merged_vertices() keeps.
+  reserve_tail(std::max(tail_, n / 16));
   choose_blending(*mapper_, shading.rgba, texture.rgba);
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
 }
 
 // replace_vertices() without allocating: the same count of vertices as held, written over the
-// old ones; the colours uploaded by the ordered mapper in one range, the positions packed by
-// VTK (below), the texture coordinates (a function of the lattice index, the same after a
-// slide) only when they differ. Measured on terrain-only slides of the Utah mosaic (1024 cells,
-// 1.06 M vertices; `terravol bench --suites build`, the viewer's frames): the frame that lands
-// a slide took 85-96 ms against 19-25 ms for the frames around it when the arrays were freed
-// before the slide and made and uploaded again after it; 51-71 ms this way (the vertices 7-8 ms
-// instead of 21-23, and the draw no longer allocates and repacks every array).
+// old ones; the positions and colours uploaded by the ordered mapper in one range (in place:
+// they go unshifted, see unshifted()), the texture coordinates (a function of the lattice
+// index, the same after a slide) only when they differ. Measured on terrain-only slides of the
+// Utah mosaic (1024 cells, 1.06 M vertices; `terravol bench --suites build`, the viewer's
+// frames): the frame that lands a slide took 85-96 ms against 19-25 ms for the frames around it
+// when the arrays were freed before the slide and made and uploaded again after it; 51-71 ms
+// with the arrays written in place and VTK packing the positions again; and its draw
+// 2-3 ms more than the quiet frames' with the positions uploaded in place too, against 11-18
+// ms more (2026-12-07, two alternating runs of each).
 bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
-  const std::size_t n = positions.size();
-  if (ordered == nullptr || split_orders() || n == 0 || n != point_rgba_.size()) return false;
+  const std::size_t n = positions.size(), held = point_rgba_.size();
+  if (ordered == nullptr || split_orders() || n == 0 || n > held + tail_) return false;
   write_vertices(0, positions, shading.rgba.data());
   if (texture_side_ > 0) {
     vtkDataArray* tcoords = poly_->GetPointData()->GetTCoords();
@@ -580,15 +606,10 @@ bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, 
     texels->Modified();
     texture_image_->Modified();
   }
-  // The positions through VTK (only their array is marked modified, so only it is packed and
-  // uploaded again), so that they get the coordinate shift a fresh upload would give them and
-  // the picture does not depend on what was uploaded before (terravol fly --resume is byte for
-  // byte); the colours in place.
-  poly_->GetPoints()->GetData()->Modified();
-  poly_->GetPoints()->Modified();
   shade_ = shading.shade;
   point_rgba_ = shading.rgba;
-  ordered->update_colors(0, n);
+  tail_ = held + tail_ - n;  // what lies beyond n (earlier merged vertices) no triangle indexes
+  ordered->update_vertices(0, n);
   choose_blending(*mapper_, shading.rgba, texture.rgba);
   poly_->Modified();
   return true;

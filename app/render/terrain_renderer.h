@@ -141,8 +141,8 @@ class TerrainRenderer {
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
   // In the bsp order, with the same vertex count as held (a terrain-only window slid: its
   // lattice and walls, no merged polygons), the arrays are written in place: no allocation;
-  // the colours are uploaded in place (OrderedPolyDataMapper::update_colors), the positions
-  // packed again by VTK (so that the picture is the one a fresh upload gives), the texture
+  // the positions and colours are uploaded in place (OrderedPolyDataMapper::update_vertices;
+  // positions go unshifted, so the picture is the one a fresh upload gives), the texture
   // coordinates only when they differ. Otherwise (and after release_vertices()) every array
   // is made and uploaded again.
   void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,

@@ -180,6 +180,59 @@ TEST(TerrainRenderer, VerticesReplacedInPlaceDrawWhatARendererMadeWithThemDraws)
   EXPECT_EQ(after.at(28, 32), (test::Rgb8{255, 255, 255})) << "the far square's new colour, uncovered";
 }
 
+// A slide with merged pieces changes the vertex count. When the new vertices fit the room
+// kept after the old ones (here the room the appended pieces left), they are written in place
+// too, and the picture is a fresh renderer's, far from the scene frame's origin as well.
+TEST(TerrainRenderer, MoreVerticesThatFitTheRoomAreWrittenInPlaceAndDrawAsAFreshRenderer) {
+  TERRAVOL_REQUIRE_DISPLAY();
+  for (const float offset : {0.0f, 60000.0f}) {
+    SCOPED_TRACE(offset);
+    TwoSquares s = two_squares(255);
+    for (glm::vec3& p : s.positions) p.x += offset;
+    s.camera.eye.x += offset;
+    TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));
+    renderer.set_camera(s.camera, 100.0);
+    // Four merged vertices appended: room for three times as many kept after them.
+    const std::vector<glm::vec3> piece{{offset - 0.5f, -0.5f, 6.0f}, {offset + 0.5f, -0.5f, 6.0f},
+                                       {offset + 0.5f, 0.5f, 6.0f}, {offset - 0.5f, 0.5f, 6.0f}};
+    const std::vector<glm::u8vec4> white(4, glm::u8vec4(255));
+    renderer.append_merged_vertices(piece, white);
+    renderer.set_frame(frame_of({4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3, 8, 9, 10, 8, 10, 11}));
+    renderer.render();
+
+    // Slid: the squares moved, and two translucent merged squares where one was.
+    std::vector<glm::vec3> moved = s.positions;
+    for (glm::vec3& p : moved) p.y += 0.5f;
+    scene::TerrainShading shading = s.shading;
+    for (int q = 0; q < 2; ++q)
+      for (const glm::vec3& p : piece) {
+        moved.push_back(p + glm::vec3(q == 0 ? -0.75f : 0.75f, 0.0f, 1.0f + q));
+        shading.shade.push_back(1.0f);
+        shading.rgba.push_back(q == 0 ? scene::Rgba{255, 255, 0, 128} : scene::Rgba{0, 255, 255, 160});
+      }
+    const std::vector<std::uint32_t> order{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3, 8, 9, 10, 8, 10, 11, 12, 13, 14, 12, 14, 15};
+    const void* storage = renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0);
+    renderer.replace_vertices(moved, shading);
+    EXPECT_EQ(renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0), storage) << "written in place";
+    renderer.set_frame(frame_of(order));
+    renderer.render();
+    const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
+
+    TerrainRenderer fresh(moved, shading, two_squares_settings(scene::DrawOrder::kBsp));
+    fresh.set_camera(s.camera, 100.0);
+    fresh.set_frame(frame_of(order));
+    fresh.render();
+    const test::Image expected = test::image_of_rgb(fresh.rgb(), 64, 64);
+    ASSERT_EQ(after.width, 64);
+    EXPECT_EQ(after.pixels, expected.pixels);
+    // The near red square under the cyan piece (x > 0), the yellow one (x < 0): both blended.
+    const test::Rgb8 left = after.at(32 - 6, 32), right = after.at(32 + 6, 32);
+    EXPECT_GT(left[0], 200);
+    EXPECT_GT(left[1], 100) << "yellow over red";
+    EXPECT_GT(right[2], 100) << "cyan over red";
+  }
+}
+
 // A textured floor (8 x 8 at z = 0, one yellow texel) and, over its left half, a run of 128
 // thin half-transparent blue triangles (merged pieces: vertex colours, texture coordinates -1)
 // at z = 1; then a textured square at z = 2 over the bottom-left quadrant. Drawn in that order,
