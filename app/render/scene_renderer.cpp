@@ -145,8 +145,8 @@ void SceneRenderer::sync_vertices(TerrainRenderer& renderer) const {
       renderer.set_vertex_version(tree.merged_version());
       return;
     }
-    const scene::TerrainShading all = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-    renderer.replace_vertices(positions, all, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+    renderer.replace_vertices(positions, scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+                              ColorTexture{scene_->cells() + 1, lattice_.rgba});
   } else if (renderer.vertex_count() < positions.size()) {
     const std::size_t have = renderer.vertex_count();
     renderer.append_merged_vertices(std::span(positions).subspan(have),
@@ -256,7 +256,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     const auto t1 = Clock::now();
     const mrbsp::TerrainTree& tree = scene_->tree();
     if (renderer_) {
-      renderer_->replace_vertices(tree.positions(), p.vertices,
+      renderer_->replace_vertices(tree.positions(), std::move(p.vertices),
                                   ColorTexture{scene_->cells() + 1, lattice_.rgba});
       renderer_->set_vertex_version(tree.merged_version());
     }
@@ -293,7 +293,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const mrbsp::TerrainTree& tree = scene_->tree();
   if (renderer_) {
     if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-    renderer_->replace_vertices(tree.positions(), p.vertices, ColorTexture{scene_->cells() + 1, lattice_.rgba});
+    renderer_->replace_vertices(tree.positions(), std::move(p.vertices), ColorTexture{scene_->cells() + 1, lattice_.rgba});
     renderer_->set_vertex_version(tree.merged_version());
   }
   p.vertices = {};

@@ -537,7 +537,7 @@ void TerrainRenderer::set_wireframe(bool on) {
   }
 }
 
-void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, scene::TerrainShading shading,
                                        const ColorTexture& texture) {
   const std::size_t n = positions.size();
   if (shading.rgba.size() != n || shading.shade.size() != n ||
@@ -568,13 +568,13 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
     copy(texture_image_->GetPointData()->GetScalars(), texture.rgba.data(), texture.rgba.size() * sizeof(scene::Rgba));
     texture_image_->Modified();
   }
-  shade_ = shading.shade;
-  point_rgba_ = shading.rgba;
+  shade_ = std::move(shading.shade);
+  point_rgba_ = std::move(shading.rgba);
   // Room after the new vertices: the frames' own (colour-box faces), the pieces later edits
   // and traversals append, and the next slide's vertices when they outnumber these (written
   // in place then, replace_in_place); a sixteenth, as append_merged_vertices() keeps.
   reserve_tail(std::max(tail_, n / 16));
-  choose_blending(*mapper_, shading.rgba, texture.rgba);
+  choose_blending(*mapper_, point_rgba_, texture.rgba);
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
 }
@@ -589,7 +589,7 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
 // with the arrays written in place and VTK packing the positions again; and its draw
 // 2-3 ms more than the quiet frames' with the positions uploaded in place too, against 11-18
 // ms more (2026-12-07, two alternating runs of each).
-bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
   const std::size_t n = positions.size(), held = point_rgba_.size();
@@ -606,11 +606,11 @@ bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, 
     texels->Modified();
     texture_image_->Modified();
   }
-  shade_ = shading.shade;
-  point_rgba_ = shading.rgba;
+  shade_ = std::move(shading.shade);
+  point_rgba_ = std::move(shading.rgba);
   tail_ = held + tail_ - n;  // what lies beyond n (earlier merged vertices) no triangle indexes
   ordered->update_vertices(0, n);
-  choose_blending(*mapper_, shading.rgba, texture.rgba);
+  choose_blending(*mapper_, point_rgba_, texture.rgba);
   poly_->Modified();
   return true;
 }

@@ -139,13 +139,14 @@ class TerrainRenderer {
   // the window). The vertex count may change (merged polygons come and go); the texture side
   // must be the constructor's, and the attribute counts must match the positions, else
   // std::invalid_argument. The triangle list is emptied until the next set_frame().
-  // In the bsp order, with the same vertex count as held (a terrain-only window slid: its
-  // lattice and walls, no merged polygons), the arrays are written in place: no allocation;
+  // In the bsp order, when the new vertices fit the arrays held (the vertices held and the
+  // room kept after them: a terrain-only window slid keeps its count; merged vertices fit the
+  // room when they grew by less than it), the arrays are written in place: no allocation;
   // the positions and colours are uploaded in place (OrderedPolyDataMapper::update_vertices;
   // positions go unshifted, so the picture is the one a fresh upload gives), the texture
   // coordinates only when they differ. Otherwise (and after release_vertices()) every array
-  // is made and uploaded again.
-  void replace_vertices(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+  // is made and uploaded again, with a sixteenth more room. The shading is moved from.
+  void replace_vertices(const std::vector<glm::vec3>& positions, scene::TerrainShading shading,
                         const ColorTexture& texture = {});
   // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only
   // appended merged vertices, so only they are added: `positions` are the new tail of the
@@ -221,7 +222,7 @@ class TerrainRenderer {
   void write_vertices(std::size_t first, std::span<const glm::vec3> positions, const void* rgba);
   // replace_vertices() over the arrays held, when it can (see there); false when it cannot,
   // with nothing changed.
-  bool replace_in_place(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+  bool replace_in_place(const std::vector<glm::vec3>& positions, scene::TerrainShading& shading,
                         const ColorTexture& texture);
   // Translucent newcomers turn the ordered mapper's blending on (it stays on: what was
   // translucent still is).
