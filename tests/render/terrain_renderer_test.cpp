@@ -138,6 +138,17 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
   }
 }
 
+// The picture a renderer made with these vertices draws of `indices` from `camera` (bsp order).
+test::Image fresh_picture(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
+                          const mrbsp::Camera& camera, const std::vector<std::uint32_t>& indices,
+                          const ColorTexture& texture = {}) {
+  TerrainRenderer fresh(positions, shading, two_squares_settings(scene::DrawOrder::kBsp), texture);
+  fresh.set_camera(camera, 100.0);
+  fresh.set_frame(frame_of(indices));
+  fresh.render();
+  return test::image_of_rgb(fresh.rgb(), 64, 64);
+}
+
 // A terrain-only slide keeps the vertex count: the renderer writes the new vertices over the
 // old ones, in the same arrays. The picture is the one a renderer made with the new vertices
 // draws.
@@ -168,11 +179,7 @@ TEST(TerrainRenderer, VerticesReplacedInPlaceDrawWhatARendererMadeWithThemDraws)
   renderer.render();
   const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
 
-  TerrainRenderer fresh(moved, recoloured, two_squares_settings(scene::DrawOrder::kBsp), {1, magenta});
-  fresh.set_camera(s.camera, 100.0);
-  fresh.set_frame(frame_of(kFarThenNear));
-  fresh.render();
-  const test::Image expected = test::image_of_rgb(fresh.rgb(), 64, 64);
+  const test::Image expected = fresh_picture(moved, recoloured, s.camera, kFarThenNear, {1, magenta});
   ASSERT_EQ(after.width, 64);
   EXPECT_EQ(after.pixels, expected.pixels);
   // Row 0 is the top of the picture; the near square now covers x from 0 to 2.
@@ -218,11 +225,7 @@ TEST(TerrainRenderer, MoreVerticesThatFitTheRoomAreWrittenInPlaceAndDrawAsAFresh
     renderer.render();
     const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
 
-    TerrainRenderer fresh(moved, shading, two_squares_settings(scene::DrawOrder::kBsp));
-    fresh.set_camera(s.camera, 100.0);
-    fresh.set_frame(frame_of(order));
-    fresh.render();
-    const test::Image expected = test::image_of_rgb(fresh.rgb(), 64, 64);
+    const test::Image expected = fresh_picture(moved, shading, s.camera, order);
     ASSERT_EQ(after.width, 64);
     EXPECT_EQ(after.pixels, expected.pixels);
     // The near red square under the cyan piece (x > 0), the yellow one (x < 0): both blended.
