@@ -1326,11 +1326,17 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
   // shared scratch (BoxScratch::tris, the frame's own vertices), so a frame with boxes runs
   // serially. On the benchmark's N44W072 view with volumes (180k merged triangles) this pass
   // took 12.6 of the traversal's 14.2 ms serially.
-  const auto estimate_of = [&](std::uint64_t item) -> std::size_t {
-    if (kind_of(item) == kEmitSlot) return m.slots[static_cast<std::size_t>(slot_of(item))].store->pieces;
-    if (kind_of(item) == kEmitBoxes) return 0;
+  // The store an item draws from, if any (a slot, or a cell's low alternative).
+  const auto store_of = [&](std::uint64_t item) -> const BspStore* {
+    if (kind_of(item) == kEmitSlot) return m.slots[static_cast<std::size_t>(slot_of(item))].store.get();
+    if (kind_of(item) == kEmitBoxes) return nullptr;
     const CellContent* content = content_of(level_index_of(item) - m.top, ci_of(item), cj_of(item));
-    return content && content->low >= 0 ? m.slots[static_cast<std::size_t>(content->low)].store->pieces : 2;
+    return content && content->low >= 0 ? m.slots[static_cast<std::size_t>(content->low)].store.get() : nullptr;
+  };
+  const auto estimate_of = [&](std::uint64_t item) -> std::size_t {
+    if (kind_of(item) == kEmitBoxes) return 0;
+    const BspStore* store = store_of(item);
+    return store ? store->pieces : 2;
   };
   // Without merged content every item is a cell of two triangles (and its crack fills): the
   // estimate and the cuts need no walk over the items.
@@ -1363,7 +1369,23 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
     Frame::EmitChunk& chunk = frame.chunks_[c];
     Sink out{c == 0 ? frame.indices : chunk.indices, c == 0 ? frame.level : chunk.level, chunk.stack};
     out.open(estimate / chunks);
-    for (std::size_t k = cut[c]; k < cut[c + 1]; ++k) emit_item(out, leaves[k]);
+    // Each store's arrays lie apart on the heap, and the walk of a small one waited mostly on
+    // their first lines: the store two items ahead and the arrays of the next one are fetched
+    // meanwhile. The benchmark's N44W072 view with volumes (10,417 items, 177k merged pieces;
+    // a still `fly`, three alternating runs): traversal 8.7-9.5 ms against 10.3-11.0.
+    for (std::size_t k = cut[c]; k < cut[c + 1]; ++k) {
+      if (k + 2 < cut[c + 1]) {
+        if (const BspStore* ahead = store_of(leaves[k + 2])) __builtin_prefetch(ahead);
+      }
+      if (k + 1 < cut[c + 1]) {
+        if (const BspStore* ahead = store_of(leaves[k + 1])) {
+          __builtin_prefetch(ahead->nodes.data());
+          __builtin_prefetch(ahead->polys.data());
+          __builtin_prefetch(ahead->refs.data());
+        }
+      }
+      emit_item(out, leaves[k]);
+    }
     chunk.triangles = out.triangles;
     chunk.crack_triangles = out.cracks;
   };
