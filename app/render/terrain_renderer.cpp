@@ -579,8 +579,9 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
   if (split_orders()) merged_poly_->Modified();
 }
 
-// replace_vertices() without allocating: the same count of vertices as held, written over the
-// old ones; the positions and colours uploaded by the ordered mapper in one range (in place:
+// replace_vertices() without allocating: when the new vertices fit the arrays (the vertices
+// held and the room after them), written over the old ones (what lies beyond them joins the
+// room); the positions and colours uploaded by the ordered mapper in one range (in place:
 // they go unshifted, see unshifted()), the texture coordinates (a function of the lattice
 // index, the same after a slide) only when they differ. Measured on terrain-only slides of the
 // Utah mosaic (1024 cells, 1.06 M vertices; `terravol bench --suites build`, the viewer's
