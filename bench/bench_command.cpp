@@ -178,9 +178,11 @@ void run_bench(const BenchOptions& o, const std::string& command) {
   if (suites.count("translucency")) {
     for (std::size_t k = 0; k < transmitters.size(); ++k)
       results["translucency"].push_back(translucency_suite(c, real[k], transmitters[k]));
-    const std::filesystem::path bundled = "data/dem/N45E006.hgt", hydrogen = data / "volume" / "hydrogen.vtk";
+    const std::filesystem::path bundled = "data/dem/N45E006.hgt",
+                                hydrogen = data / "volume" / "hydrogen.vtk";
     if (!std::filesystem::exists(bundled) || !std::filesystem::exists(hydrogen)) {
-      c.log(bundled.string() + " or " + hydrogen.string() + " not found: the hydrogen.vtk figure is skipped");
+      c.log(bundled.string() + " or " + hydrogen.string() +
+            " not found: the hydrogen.vtk figure is skipped");
     } else {
       c.log("translucency: hydrogen.vtk over the bundled DEM, five cameras");
       results["hydrogen"] = hydrogen_pieces(c, bundled, hydrogen);

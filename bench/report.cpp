@@ -191,10 +191,11 @@ void translucency_section(std::ostringstream& md, const json& results) {
 void hydrogen_section(std::ostringstream& md, const json& results) {
   if (!results.contains("hydrogen")) return;
   const json& h = results["hydrogen"];
-  md << "**A closed surface:** hydrogen.vtk's isosurface at 0.02 (" << h["input_triangles"].get<std::size_t>()
+  md << "**A closed surface:** hydrogen.vtk's isosurface at 0.02 ("
+     << h["input_triangles"].get<std::size_t>()
      << " triangles) 1900 m up over the bundled DEM, from " << h["cameras"].get<std::size_t>()
-     << " cameras: the tree stores " << spread(h["pieces_per_triangle"], "%.3f") << " pieces per input triangle; merge "
-     << spread(h["merge_ms"], "%.0f") << " ms.\n\n";
+     << " cameras: the tree stores " << spread(h["pieces_per_triangle"], "%.3f")
+     << " pieces per input triangle; merge " << spread(h["merge_ms"], "%.0f") << " ms.\n\n";
 }
 
 void scaling_section(std::ostringstream& md, const json& results, const std::filesystem::path& dir) {

@@ -175,7 +175,8 @@ json terrain_suite(const BenchConfig& c, const Terrain& terrain) {
   return out;
 }
 
-json hydrogen_pieces(const BenchConfig& c, const std::filesystem::path& dem, const std::filesystem::path& volume) {
+json hydrogen_pieces(const BenchConfig& c, const std::filesystem::path& dem,
+                     const std::filesystem::path& volume) {
   // Issue 11's closed-surface figure: the molecule 64 m across, about 1900 m up among the
   // Vanoise's valleys and ridges (as `terravol render DEM --volume hydrogen.vtk --iso 0.02
   // --volume-frame enu:45.5,6.5,1900 --camera ... --stats` draws it). The window follows the
@@ -202,10 +203,13 @@ json hydrogen_pieces(const BenchConfig& c, const std::filesystem::path& dem, con
     scene.render(pose, false, 45.0, mrbsp::TraversalOptions{});
     const app::scene::MergeFigures& m = scene.merge_figures();
     input = m.input_triangles;
-    ratio.push_back(static_cast<double>(m.tree_triangles) / static_cast<double>(std::max<std::size_t>(m.input_triangles, 1)));
+    ratio.push_back(static_cast<double>(m.tree_triangles) /
+                    static_cast<double>(std::max<std::size_t>(m.input_triangles, 1)));
     merge_ms.push_back(m.merge_ms);
   }
-  return {{"input_triangles", input}, {"cameras", cameras.size()}, {"pieces_per_triangle", to_json(summarize(ratio))},
+  return {{"input_triangles", input},
+          {"cameras", cameras.size()},
+          {"pieces_per_triangle", to_json(summarize(ratio))},
           {"merge_ms", to_json(summarize(merge_ms))}};
 }
 

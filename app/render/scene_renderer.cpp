@@ -145,8 +145,9 @@ void SceneRenderer::sync_vertices(TerrainRenderer& renderer) const {
       renderer.set_vertex_version(tree.merged_version());
       return;
     }
-    renderer.replace_vertices(positions, scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
-                              ColorTexture{scene_->cells() + 1, lattice_.rgba});
+    renderer.replace_vertices(
+        positions, scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors()),
+        ColorTexture{scene_->cells() + 1, lattice_.rgba});
   } else if (renderer.vertex_count() < positions.size()) {
     const std::size_t have = renderer.vertex_count();
     renderer.append_merged_vertices(std::span(positions).subspan(have),
@@ -293,7 +294,8 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const mrbsp::TerrainTree& tree = scene_->tree();
   if (renderer_) {
     if (p.vertices.rgba.empty()) p.vertices = scene::vertex_shading(lattice_, tree.merged_base(), tree.merged_colors());
-    renderer_->replace_vertices(tree.positions(), std::move(p.vertices), ColorTexture{scene_->cells() + 1, lattice_.rgba});
+    renderer_->replace_vertices(tree.positions(), std::move(p.vertices),
+                                ColorTexture{scene_->cells() + 1, lattice_.rgba});
     renderer_->set_vertex_version(tree.merged_version());
   }
   p.vertices = {};

@@ -537,8 +537,8 @@ void TerrainRenderer::set_wireframe(bool on) {
   }
 }
 
-void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, scene::TerrainShading shading,
-                                       const ColorTexture& texture) {
+void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions,
+                                       scene::TerrainShading shading, const ColorTexture& texture) {
   const std::size_t n = positions.size();
   if (shading.rgba.size() != n || shading.shade.size() != n ||
       texture.side != texture_side_ || (texture_side_ > 0 && shading.tcoords.size() != n) ||
@@ -590,7 +590,8 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions, 
 // with the arrays written in place and VTK packing the positions again; and its draw
 // 2-3 ms more than the quiet frames' with the positions uploaded in place too, against 11-18
 // ms more (2026-12-07, two alternating runs of each).
-bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions, scene::TerrainShading& shading,
+bool TerrainRenderer::replace_in_place(const std::vector<glm::vec3>& positions,
+                                       scene::TerrainShading& shading,
                                        const ColorTexture& texture) {
   auto* ordered = OrderedPolyDataMapper::SafeDownCast(mapper_);
   const std::size_t n = positions.size(), held = point_rgba_.size();

@@ -139,8 +139,9 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
 }
 
 // The picture a renderer made with these vertices draws of `indices` from `camera` (bsp order).
-test::Image fresh_picture(const std::vector<glm::vec3>& positions, const scene::TerrainShading& shading,
-                          const mrbsp::Camera& camera, const std::vector<std::uint32_t>& indices,
+test::Image fresh_picture(const std::vector<glm::vec3>& positions,
+                          const scene::TerrainShading& shading, const mrbsp::Camera& camera,
+                          const std::vector<std::uint32_t>& indices,
                           const ColorTexture& texture = {}) {
   TerrainRenderer fresh(positions, shading, two_squares_settings(scene::DrawOrder::kBsp), texture);
   fresh.set_camera(camera, 100.0);
@@ -179,7 +180,8 @@ TEST(TerrainRenderer, VerticesReplacedInPlaceDrawWhatARendererMadeWithThemDraws)
   renderer.render();
   const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
 
-  const test::Image expected = fresh_picture(moved, recoloured, s.camera, kFarThenNear, {1, magenta});
+  const test::Image expected =
+      fresh_picture(moved, recoloured, s.camera, kFarThenNear, {1, magenta});
   ASSERT_EQ(after.width, 64);
   EXPECT_EQ(after.pixels, expected.pixels);
   // Row 0 is the top of the picture; the near square now covers x from 0 to 2.
@@ -200,8 +202,10 @@ TEST(TerrainRenderer, MoreVerticesThatFitTheRoomAreWrittenInPlaceAndDrawAsAFresh
     TerrainRenderer renderer(s.positions, s.shading, two_squares_settings(scene::DrawOrder::kBsp));
     renderer.set_camera(s.camera, 100.0);
     // Four merged vertices appended: room for three times as many kept after them.
-    const std::vector<glm::vec3> piece{{offset - 0.5f, -0.5f, 6.0f}, {offset + 0.5f, -0.5f, 6.0f},
-                                       {offset + 0.5f, 0.5f, 6.0f}, {offset - 0.5f, 0.5f, 6.0f}};
+    const std::vector<glm::vec3> piece{{offset - 0.5f, -0.5f, 6.0f},
+                                       {offset + 0.5f, -0.5f, 6.0f},
+                                       {offset + 0.5f, 0.5f, 6.0f},
+                                       {offset - 0.5f, 0.5f, 6.0f}};
     const std::vector<glm::u8vec4> white(4, glm::u8vec4(255));
     renderer.append_merged_vertices(piece, white);
     renderer.set_frame(frame_of({4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3, 8, 9, 10, 8, 10, 11}));
@@ -215,12 +219,15 @@ TEST(TerrainRenderer, MoreVerticesThatFitTheRoomAreWrittenInPlaceAndDrawAsAFresh
       for (const glm::vec3& p : piece) {
         moved.push_back(p + glm::vec3(q == 0 ? -0.75f : 0.75f, 0.0f, 1.0f + q));
         shading.shade.push_back(1.0f);
-        shading.rgba.push_back(q == 0 ? scene::Rgba{255, 255, 0, 128} : scene::Rgba{0, 255, 255, 160});
+        shading.rgba.push_back(q == 0 ? scene::Rgba{255, 255, 0, 128}
+                                      : scene::Rgba{0, 255, 255, 160});
       }
-    const std::vector<std::uint32_t> order{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3, 8, 9, 10, 8, 10, 11, 12, 13, 14, 12, 14, 15};
+    const std::vector<std::uint32_t> order{4, 5, 6,  4, 6,  7,  0,  1,  2,  0,  2,  3,
+                                           8, 9, 10, 8, 10, 11, 12, 13, 14, 12, 14, 15};
     const void* storage = renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0);
     renderer.replace_vertices(moved, shading);
-    EXPECT_EQ(renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0), storage) << "written in place";
+    EXPECT_EQ(renderer.scene()->GetPoints()->GetData()->GetVoidPointer(0), storage)
+        << "written in place";
     renderer.set_frame(frame_of(order));
     renderer.render();
     const test::Image after = test::image_of_rgb(renderer.rgb(), 64, 64);
