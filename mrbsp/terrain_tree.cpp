@@ -305,9 +305,18 @@ std::size_t SurfacePieces::bytes() const {
 }
 
 void SurfacePieces::keep(std::vector<Piece>& gathered) {
-  std::stable_sort(gathered.begin(), gathered.end(), [](const Piece& a, const Piece& b) { return a.slot < b.slot; });
+  // A slide gathers the pieces it keeps in order (renamed runs), then the few it sends through
+  // the moved window: only what follows the sorted start is sorted, then merged in. Both steps
+  // are stable, so the order is a stable sort's of the whole. Sorting all of it took 1-5 ms per
+  // surface of the bench's Utah slide.
+  const auto by_slot = [](const Piece& a, const Piece& b) { return a.slot < b.slot; };
+  const auto sorted_end = std::is_sorted_until(gathered.begin(), gathered.end(), by_slot);
+  std::stable_sort(sorted_end, gathered.end(), by_slot);
+  std::inplace_merge(gathered.begin(), sorted_end, gathered.end(), by_slot);
+  std::size_t kept_refs = 0;  // refs may hold more (a slide's dropped pieces)
+  for (const Piece& p : gathered) kept_refs += p.count;
   std::vector<std::uint32_t> sorted;
-  sorted.reserve(refs.size());
+  sorted.reserve(kept_refs);
   runs.clear();
   std::vector<std::uint16_t>().swap(counts);
   counts.reserve(gathered.size());

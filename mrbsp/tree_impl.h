@@ -227,7 +227,8 @@ struct SurfacePieces {
     if (at != runs.end() && at->slot == key) for_each_in_run(static_cast<std::size_t>(at - runs.begin()), f);
   }
   // Keeps `gathered` (pieces into refs, in any order): sorted by slot (stable), refs reordered
-  // to match. Throws std::length_error for a piece of more than 65535 vertices.
+  // to match; references no piece of `gathered` points to are dropped. Throws std::length_error
+  // for a piece of more than 65535 vertices.
   void keep(std::vector<Piece>& gathered);
 };
 
