@@ -68,7 +68,8 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
 // up to `terrain_vertices` (TerrainTree::merged_base()) are the walls' (the tree's window sides
 // seen from beyond), kWallColor; the vertices after it are merged polygons', with
 // `merged_colors`. Walls and merged polygons have normal +z, shade 1 and texture coordinates
-// (-1, -1) (the renderer draws their own colour there, not the texture). Precondition:
+// (-1, -1) (the renderer draws their own colour there, not the texture). `shade` and `rgba`
+// have room for a sixteenth more vertices, untouched (see the definition). Precondition:
 // lattice from shade_terrain.
 TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
                               std::span<const glm::u8vec4> merged_colors);
