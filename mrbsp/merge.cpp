@@ -700,8 +700,8 @@ class SlotBuilder {
   // through the sphere, and a candidate stops being counted once its spans alone score worse
   // than the best so far. The candidates are screened on 32 of the samples first, and the
   // best few (kFinalists, 3 then) scored on all of them. 16 candidates over 512 samples so:
-  // hydrogen 1.47x, the benchmark scene 2.03x, the merge 1.3-1.4x the time of 6 candidates over 40 unscreened
-  // (1.73x and 2.18x); 12 over 256: 1.51x and 2.06x, 1.15x the time.
+  // hydrogen 1.47x, the benchmark scene 2.03x, the merge 1.3-1.4x the time of 6 candidates
+  // over 40 unscreened (1.73x and 2.18x); 12 over 256: 1.51x and 2.06x, 1.15x the time.
   // Besides the polygons' own planes, vertical planes through the edges of nearly horizontal
   // polygons are candidates: a surface over the ground such as an agl slice is a height field
   // on the volume's lattice, and the vertical planes through its edges order it as the

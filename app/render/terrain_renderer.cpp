@@ -572,8 +572,9 @@ void TerrainRenderer::replace_vertices(const std::vector<glm::vec3>& positions,
   point_rgba_ = std::move(shading.rgba);
   // Room after the new vertices: the frames' own (colour-box faces), the pieces later edits
   // and traversals append, and the next slide's vertices when they outnumber these (written
-  // in place then, replace_in_place); a sixteenth, as append_merged_vertices() keeps.
-  reserve_tail(std::max(tail_, n / 16));
+  // in place then, replace_in_place): n / scene::kVertexRoom, as append_merged_vertices()
+  // keeps.
+  reserve_tail(std::max(tail_, n / scene::kVertexRoom));
   choose_blending(*mapper_, point_rgba_, texture.rgba);
   poly_->Modified();
   if (split_orders()) merged_poly_->Modified();
@@ -660,10 +661,11 @@ void TerrainRenderer::append_merged_vertices(std::span<const glm::vec3> position
     grow(poly_->GetPointData()->GetTCoords(), none.data(), sizeof(glm::vec2));
   }
   // The frames' own vertices after the new ones, and room for about three more appends as
-  // large as this one (an edit's) or a sixteenth of the vertices (lazily built pieces come in
-  // small appends between an edit's large ones), to be written in place (above).
+  // large as this one (an edit's) or the vertices' count / scene::kVertexRoom (lazily built
+  // pieces come in small appends between an edit's large ones), to be written in place
+  // (above).
   if (ordered != nullptr && !split_orders()) {
-    reserve_tail(std::max({tail_, 3 * positions.size(), point_rgba_.size() / 16}));
+    reserve_tail(std::max({tail_, 3 * positions.size(), point_rgba_.size() / scene::kVertexRoom}));
   } else if (tail_ > 0) {
     reserve_tail(tail_);
   }

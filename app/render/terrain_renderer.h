@@ -145,7 +145,8 @@ class TerrainRenderer {
   // the positions and colours are uploaded in place (OrderedPolyDataMapper::update_vertices;
   // positions go unshifted, so the picture is the one a fresh upload gives), the texture
   // coordinates only when they differ. Otherwise (and after release_vertices()) every array
-  // is made and uploaded again, with a sixteenth more room. The shading is moved from.
+  // is made and uploaded again, with room for count / scene::kVertexRoom more. The shading is
+  // moved from.
   void replace_vertices(const std::vector<glm::vec3>& positions, scene::TerrainShading shading,
                         const ColorTexture& texture = {});
   // Edits and lazily built pieces (TerrainTree::merged_version() unchanged): the tree only

@@ -174,12 +174,12 @@ TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain
   const auto side = static_cast<std::size_t>(std::lround(std::sqrt(static_cast<double>(samples))));
   TerrainShading out;
   // The renderer keeps `shade` and `rgba` and appends the vertices of low alternatives built
-  // when first drawn; its vertex arrays keep room for a sixteenth more, and these get the same
-  // (reserved, not touched: no memory is used until they grow into it). Made exactly, the first
-  // such append after a slide over the benchmark's Utah volumes reallocated both (1.7 M
-  // vertices) on the viewer's thread: 20-30 ms of that frame, most of it fresh pages.
-  out.shade.reserve(total + total / 16);
-  out.rgba.reserve(total + total / 16);
+  // when first drawn, in the room its vertex arrays keep; these get the same room (reserved,
+  // not touched: no memory is used until they grow into it). Made exactly, the first such
+  // append after a slide over the benchmark's Utah volumes reallocated both (1.7 M vertices)
+  // on the viewer's thread: 20-30 ms of that frame, most of it fresh pages.
+  out.shade.reserve(total + total / kVertexRoom);
+  out.rgba.reserve(total + total / kVertexRoom);
   out.shade.resize(total);
   out.rgba.resize(total);
   out.tcoords.resize(total, glm::vec2(-1.0f));

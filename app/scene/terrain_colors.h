@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -63,13 +64,18 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
                              std::span<const float> z, std::span<const float> heights,
                              const ShadingOptions& options);
 
+// The room kept after the tree's vertices for those appended later (merged pieces built when
+// first drawn, a frame's own faces), as a divisor of their count: the renderer's vertex arrays
+// keep count / kVertexRoom more, and so do vertex_shading's `shade` and `rgba`.
+inline constexpr std::size_t kVertexRoom = 16;
+
 // The attributes of the tree's vertices (TerrainTree::positions()): vertex v below the
 // lattice's sample count is lattice sample v and copies its attributes; the vertices from there
 // up to `terrain_vertices` (TerrainTree::merged_base()) are the walls' (the tree's window sides
 // seen from beyond), kWallColor; the vertices after it are merged polygons', with
 // `merged_colors`. Walls and merged polygons have normal +z, shade 1 and texture coordinates
 // (-1, -1) (the renderer draws their own colour there, not the texture). `shade` and `rgba`
-// have room for a sixteenth more vertices, untouched (see the definition). Precondition:
+// have room for total / kVertexRoom more vertices, untouched. Precondition:
 // lattice from shade_terrain.
 TerrainShading vertex_shading(const TerrainShading& lattice, std::size_t terrain_vertices,
                               std::span<const glm::u8vec4> merged_colors);

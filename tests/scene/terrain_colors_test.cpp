@@ -85,16 +85,16 @@ TEST(TerrainColors, WallVerticesTakeTheWallColourAndNoTexture) {
 }
 
 // The renderer appends lazily built merged vertices to the shade and colours it keeps: they
-// come with room for a sixteenth more, so that those appends do not move them.
-TEST(TerrainColors, VertexShadingLeavesRoomForASixteenthMoreVertices) {
+// come with the room the renderer keeps, so that those appends do not move them.
+TEST(TerrainColors, VertexShadingLeavesTheRenderersRoomForMoreVertices) {
   const auto s = shade(lattice([](double x, double) { return static_cast<float>(x); }));
   const std::vector<glm::u8vec4> merged(300, glm::u8vec4{9, 9, 9, 200});
   const auto v = vertex_shading(s, 25, merged);
   const std::size_t total = 25 + 300;
   ASSERT_EQ(v.rgba.size(), total);
   ASSERT_EQ(v.shade.size(), total);
-  EXPECT_GE(v.rgba.capacity(), total + total / 16);
-  EXPECT_GE(v.shade.capacity(), total + total / 16);
+  EXPECT_GE(v.rgba.capacity(), total + total / kVertexRoom);
+  EXPECT_GE(v.shade.capacity(), total + total / kVertexRoom);
 }
 
 TEST(TerrainColors, LodColoursAreDistinctAndNeverMagenta) {
