@@ -234,10 +234,10 @@ void BoxScratch::to_outside(const TerrainTree::Impl& m, int side, const Part& p,
     if (fresh) outside_places_[static_cast<std::size_t>(side)].push_back({band, column, find(bucket_key)});
   };
   const auto to_columns = [&](int band, Part q) {
-    const int columns = m.cells_at(0), s0 = m.cell_size(0);
+    const int columns = m.place_columns();
     for (int column = 0; column + 1 < columns; ++column) {
       Part west{}, east{};  // south and north of the line for west and east's rows
-      const double line = m.column_lines(side)[static_cast<std::size_t>((column + 1) * s0)];
+      const double line = m.place_line(side, column + 1);
       const int c = cut(q, m.column_axis(side), line, tol, west, east);
       if (c < 0) {
         to_place(band, column, q);

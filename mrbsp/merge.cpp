@@ -347,14 +347,13 @@ class Distributor {
   // A band's part cut into the window's level-0 columns (south and north) or rows (west and
   // east; Impl::column_axis); a kept place's pieces are there already (run_outside).
   void to_columns(int side, int band, std::uint32_t first, std::uint32_t count) {
-    const int columns = m_.cells_at(0), s0 = m_.cell_size(0), axis = m_.column_axis(side);
+    const int columns = m_.place_columns(), step = m_.place_step(), axis = m_.column_axis(side);
     for (int column = 0; column < columns; ++column) {
       std::uint32_t in_first = first, in_count = count;
       bool rest = false;
       if (column + 1 < columns) {
-        const int i = (column + 1) * s0;
-        const Parts p = split_axis(first, count, axis, m_.column_lines(side)[static_cast<std::size_t>(i)],
-                                   axis == 0 ? x_plane(i) : y_plane(i));
+        const int i = (column + 1) * step;
+        const Parts p = split_axis(first, count, axis, m_.place_line(side, column + 1), axis == 0 ? x_plane(i) : y_plane(i));
         in_first = p.back_first;  // west (south) of the line (a piece in it goes there)
         in_count = p.back_count;
         first = p.front_first;
@@ -1736,18 +1735,18 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
   start_change(merge_stats);
   // The overlap in the moved window's indices; a cell there was (ci + di / s, cj + dj / s).
   const Region kept{std::max(0, -di), std::max(0, -dj), n - std::max(0, di), n - std::max(0, dj)};
-  // An outside place lies where one lay before when both are one level-0 cell wide between the
-  // same planes: west and east bands move by di / s0 bands and their rows by dj / s0 rows;
-  // south and north bands by dj / s0 bands and their columns by di / s0 columns. The last bands
+  // An outside place lies where one lay before when both lie between the same planes: west and
+  // east bands move by di / s0 bands and their rows by dj / row rows (row: place_step());
+  // south and north bands by dj / s0 bands and their columns by di / row columns. The last bands
   // (everything beyond) stay only where their plane did not move, and so do the first and last
   // rows (which reach beyond the south and north planes) where the window did not move north or
   // south. (The columns of south and north lie between the west and east planes.)
-  const int s0 = cell_size(0), columns = cells_at(0);
+  const int s0 = cell_size(0), columns = place_columns(), row = place_step();
   const auto moved_place = [&](SlotKey key) -> std::optional<SlotKey> {
     const OutsidePlace p = outside_place(key);
     // A band beyond a plane that moved toward it is nearer now, and farther when it moved away.
     const int shift = p.side == 0 ? di / s0 : p.side == 1 ? -di / s0 : p.side == 2 ? dj / s0 : -dj / s0;
-    const int across = (p.side < 2 ? dj : di) / s0;  // the rows' or columns' move
+    const int across = (p.side < 2 ? dj : di) / row;  // the rows' or columns' move
     const int band = p.band == kBands - 1 ? p.band : p.band + shift, column = p.column - across;
     if (p.band == kBands - 1 ? shift != 0 : band < 0 || band >= kBands - 1) return std::nullopt;
     if (p.side < 2) {

@@ -786,14 +786,12 @@ void TerrainTree::traverse(const Camera& camera, const TraversalOptions& options
       // distance to the row's bounds within the window orders them the same among parallel
       // slabs.)
       const double eye_at = side < 2 ? e.x : e.y, eye_across = side < 2 ? e.y : e.x;
-      const std::vector<double>& lines = m.column_lines(side);
-      const int s0 = m.cell_size(0);
       places.clear();
       const auto place = [&](int band, int column, std::uint64_t item) {
         const double a = m.band_plane(side, band);
         const double b = band + 1 < kBands ? m.band_plane(side, band + 1) : (side % 2 == 0 ? -INFINITY : INFINITY);
-        const double x0 = lines[static_cast<std::size_t>(column * s0)];
-        const double x1 = lines[static_cast<std::size_t>((column + 1) * s0)];
+        const double x0 = m.place_line(side, column);
+        const double x1 = m.place_line(side, column + 1);
         const double column_distance =
             eye_across < x0 ? x0 - eye_across : eye_across > x1 ? eye_across - x1 : 0.0;
         const double lo = std::min(a, b), hi = std::max(a, b);

@@ -136,15 +136,16 @@ struct BspStore {
 // beyond two belongs to the first), in bands one level-0 cell wide parallel to the plane: band
 // b of the west side lies between the planes x = xs[0] - (b + 1) w and x = xs[0] - b w (w the
 // level-0 cell's width), the last band (kBands - 1) everything beyond; each band is cut further
-// into the window's level-0 rows (west and east: its "columns" lie along y, the first and last
-// reaching beyond the south and north planes) or columns (south and north, which lie between
-// the west and east planes). A slide by whole level-0 cells keeps most of them
-// (Impl::shift_merged), and they are built apart (in parallel, and none as large as a band: the
-// band a slide fills with the column that left the window held 10,000 pieces of the
-// benchmark's Utah volumes and took 25-34 ms to build alone).
+// into rows a quarter of a level-0 cell wide (Impl::place_step; west and east: its "columns"
+// lie along y, the first and last reaching beyond the south and north planes) or such columns
+// (south and north, which lie between the west and east planes). A slide by whole level-0
+// cells keeps most of them (Impl::shift_merged), and they are built apart (in parallel, and
+// none as large as a band: the band a slide fills with the column that left the window held
+// 10,000 pieces of the benchmark's Utah volumes and took 25-34 ms to build alone; a level-0
+// row of it still 4,679 pieces and 30-38 ms).
 enum class SlotKind : std::uint8_t { kAbove = 0, kLow = 1, kOutside = 2 };
 inline constexpr int kBands = 16;
-inline constexpr int kMaxColumns = 32768;  // level-0 columns of a window, at most
+inline constexpr int kMaxColumns = 32768;  // place columns of a window (at most its cells), at most
 
 // A slot's key: the cell's global id (Impl::cell_id) times 2 plus the kind, or for kOutside
 // outside_key(side, band, column) (side 0 west, 1 east, 2 south, 3 north; column 0 for west and
@@ -322,11 +323,20 @@ struct TerrainTree::Impl {
   // boundary plane itself) and its width (a level-0 cell's), along x for west and east, y for
   // south and north.
   double band_plane(int side, int band) const;
-  // How the outside places of `side` are cut across its bands: along y into the window's level-0
-  // rows (west and east) or along x into its level-0 columns (south and north). The axis, and
-  // the plane offsets (xs or ys) whose every cell_size(0)-th entry bounds a column.
+  // How the outside places of `side` are cut across its bands: along y into rows (west and
+  // east) or along x into columns (south and north), each place_step() samples wide: a quarter
+  // of a level-0 cell (at least one sample), place_columns() of them. The axis, and the plane
+  // offset where column c begins (c = place_columns(): where the last ends).
+  // A quarter rather than a whole level-0 cell (2026-12-07): the place a slide fills with the
+  // column that left the window held 4,679 pieces of the benchmark's Utah volumes and took
+  // 30-38 ms to build, alone on one core, of slot builds of 38-45 ms in all on two.
+  static constexpr int kPlacesPerCell = 4;
   int column_axis(int side) const { return side < 2 ? 1 : 0; }
-  const std::vector<double>& column_lines(int side) const { return side < 2 ? ys : xs; }
+  int place_step() const { return std::max(1, cell_size(0) / kPlacesPerCell); }
+  int place_columns() const { return n / place_step(); }
+  double place_line(int side, int c) const {
+    return (side < 2 ? ys : xs)[static_cast<std::size_t>(c) * static_cast<std::size_t>(place_step())];
+  }
   // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
   // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the
   // triangles reaching beyond the overlap merged into the rest of the window.
