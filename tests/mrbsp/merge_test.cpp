@@ -473,6 +473,35 @@ TEST(Merge, PiecesAboveTheTerrainStayWholeAndPiecesBelowItAreDropped) {
   EXPECT_GT(stats.dropped_pieces, 0u);
 }
 
+// A small BSP of more pieces than one thread builds (SlotBuilder::kHalvedBuild, 2,048): 2,600
+// small triangles above the terrain over one level-0 cell, all in its above slot, built in
+// two halves at once and joined. It keeps the brute-force ray order from eyes among, above and beside
+// the triangles, and draws each of them whole, once.
+TEST(Merge, ASmallBspOfThousandsOfPiecesBuiltInTwoHalvesKeepsTheOrderAndTheArea) {
+  std::mt19937 rng(11);
+  TestWindow w(16, [](int i, int j) { return static_cast<float>(10 * i + 5 * j); });  // up to 240 m
+  TerrainTree tree(w.view(), 3);  // level 0: 4 x 4 cells of 400 m
+  std::uniform_real_distribution<double> xy(420.0, 780.0), z(300.0, 700.0), small(-12.0, 12.0);
+  Soup soup;
+  for (int k = 0; k < 2600; ++k) {
+    const glm::dvec3 a(xy(rng), xy(rng), z(rng));
+    soup.add(a, a + glm::dvec3(small(rng), small(rng), small(rng)), a + glm::dvec3(small(rng), small(rng), small(rng)));
+  }
+  const MergeStats stats = tree.merge(soup.v, soup.c, soup.t);
+  EXPECT_EQ(stats.slots, 1u);
+  EXPECT_GE(stats.stored_polygons, stats.input_triangles);
+  std::uniform_real_distribution<double> eye_xy(0.0, 1600.0), eye_z(260.0, 1000.0);
+  Frame f;
+  for (int trial = 0; trial < 8; ++trial) {
+    const SeededView view = seeded_view(rng, eye_xy, eye_z, -0.3, 0.5);
+    TraversalOptions o;
+    o.cull = false;
+    tree.traverse(view.camera, o, f);
+    EXPECT_NEAR(drawn_merged_area(tree, f), soup.area, 1e-6 * soup.area) << "trial " << trial;
+    EXPECT_EQ(order_violations(tree, f, view.eye, 150, rng, true), 0) << "trial " << trial;
+  }
+}
+
 // A height field on lines x = c and y = c (as a slice of a geographic volume lies on its
 // lattice's meridians and parallels), wavy and entirely above the terrain: its small BSP
 // separates its cells by those planes (axis_split) and cuts none of its triangles, and it
