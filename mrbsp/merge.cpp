@@ -37,8 +37,8 @@
 #include <vector>
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/partitioner.h>
 
 #include <glm/geometric.hpp>
@@ -345,8 +345,9 @@ class Distributor {
       count = far_count;
     }
   }
-  // A band's part cut into the window's level-0 columns (south and north) or rows (west and
-  // east; Impl::column_axis); a kept place's pieces are there already (run_outside).
+  // A band's part cut into the places' columns (south and north) or rows (west and east;
+  // Impl::column_axis, Impl::place_step); a kept place's pieces are there already
+  // (run_outside).
   void to_columns(int side, int band, std::uint32_t first, std::uint32_t count) {
     const int columns = m_.place_columns(), step = m_.place_step(), axis = m_.column_axis(side);
     for (int column = 0; column < columns; ++column) {
@@ -354,7 +355,8 @@ class Distributor {
       bool rest = false;
       if (column + 1 < columns) {
         const int i = (column + 1) * step;
-        const Parts p = split_axis(first, count, axis, m_.place_line(side, column + 1), axis == 0 ? x_plane(i) : y_plane(i));
+        const Parts p =
+            split_axis(first, count, axis, m_.place_line(side, column + 1), axis == 0 ? x_plane(i) : y_plane(i));
         in_first = p.back_first;  // west (south) of the line (a piece in it goes there)
         in_count = p.back_count;
         first = p.front_first;
@@ -627,7 +629,8 @@ class SlotBuilder {
     const std::uint32_t first = static_cast<std::uint32_t>(ids_.size());
     for (std::uint32_t k = 0; k < p.count; ++k) {
       const std::uint32_t v = from.ids_[p.first + k];
-      const auto [it, fresh] = local_.try_emplace(kAdopted | v, static_cast<std::uint32_t>(pos_.size()));
+      const auto [it, fresh] =
+          local_.try_emplace(kAdopted | v, static_cast<std::uint32_t>(pos_.size()));
       if (fresh) {
         pos_.push_back(from.pos_[v]);
         col_.push_back(from.col_[v]);

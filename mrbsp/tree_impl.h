@@ -335,7 +335,8 @@ struct TerrainTree::Impl {
   int place_step() const { return std::max(1, cell_size(0) / kPlacesPerCell); }
   int place_columns() const { return n / place_step(); }
   double place_line(int side, int c) const {
-    return (side < 2 ? ys : xs)[static_cast<std::size_t>(c) * static_cast<std::size_t>(place_step())];
+    const auto at = static_cast<std::size_t>(c) * static_cast<std::size_t>(place_step());
+    return (side < 2 ? ys : xs)[at];
   }
   // After refresh() moved the lattice by (di, dj): slots and pieces of cells in both windows
   // renamed (and the lattice vertices of their terrain triangles), the others dropped, and the

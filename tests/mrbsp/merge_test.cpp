@@ -475,8 +475,8 @@ TEST(Merge, PiecesAboveTheTerrainStayWholeAndPiecesBelowItAreDropped) {
 
 // A small BSP of more pieces than one thread builds (SlotBuilder::kHalvedBuild, 2,048): 2,600
 // small triangles above the terrain over one level-0 cell, all in its above slot, built in
-// two halves at once and joined. It keeps the brute-force ray order from eyes among, above and beside
-// the triangles, and draws each of them whole, once.
+// two halves at once and joined. It keeps the brute-force ray order from eyes among, above
+// and beside the triangles, and draws each of them whole, once.
 TEST(Merge, ASmallBspOfThousandsOfPiecesBuiltInTwoHalvesKeepsTheOrderAndTheArea) {
   std::mt19937 rng(11);
   TestWindow w(16, [](int i, int j) { return static_cast<float>(10 * i + 5 * j); });  // up to 240 m
@@ -485,7 +485,9 @@ TEST(Merge, ASmallBspOfThousandsOfPiecesBuiltInTwoHalvesKeepsTheOrderAndTheArea)
   Soup soup;
   for (int k = 0; k < 2600; ++k) {
     const glm::dvec3 a(xy(rng), xy(rng), z(rng));
-    soup.add(a, a + glm::dvec3(small(rng), small(rng), small(rng)), a + glm::dvec3(small(rng), small(rng), small(rng)));
+    const auto near_a = [&] { return a + glm::dvec3(small(rng), small(rng), small(rng)); };
+    const glm::dvec3 b = near_a();
+    soup.add(a, b, near_a());
   }
   const MergeStats stats = tree.merge(soup.v, soup.c, soup.t);
   EXPECT_EQ(stats.slots, 1u);
