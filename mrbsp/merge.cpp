@@ -480,13 +480,8 @@ class SlotBuilder {
     const std::uint32_t first = static_cast<std::uint32_t>(ids_.size());
     for (std::uint32_t v : refs) {
       const std::uint64_t key = static_cast<std::uint64_t>(surface_id) << 32 | v;
-      const auto [it, fresh] = local_.try_emplace(key, static_cast<std::uint32_t>(pos_.size()));
-      if (fresh) {
-        pos_.push_back(surface.vertices[v]);
-        col_.push_back(surface.colors[v]);
-        tc_.push_back(surface.tcoords.empty() ? kNoTcoord : surface.tcoords[v]);
-      }
-      ids_.push_back(it->second);
+      ids_.push_back(local_vertex(key, surface.vertices[v], surface.colors[v],
+                                  surface.tcoords.empty() ? kNoTcoord : surface.tcoords[v]));
     }
     Poly p{first, static_cast<std::uint32_t>(refs.size()), kMergedLevel, false, {}, surface_id};
     p.flat = plane_of(p, p.plane);
@@ -622,6 +617,18 @@ class SlotBuilder {
     p.radius = std::sqrt(r2);
   }
 
+  // The local vertex of `key` (a surface's vertex, or an adopted one), made the first time.
+  std::uint32_t local_vertex(std::uint64_t key, const glm::dvec3& position, glm::u8vec4 color,
+                             glm::vec2 tcoord) {
+    const auto [it, fresh] = local_.try_emplace(key, static_cast<std::uint32_t>(pos_.size()));
+    if (fresh) {
+      pos_.push_back(position);
+      col_.push_back(color);
+      tc_.push_back(tcoord);
+    }
+    return it->second;
+  }
+
   // Takes a polygon of another builder (of an above or outside slot: no lattice vertices), its
   // vertices copied once each.
   void adopt(const SlotBuilder& from, const Poly& p) {
@@ -629,14 +636,7 @@ class SlotBuilder {
     const std::uint32_t first = static_cast<std::uint32_t>(ids_.size());
     for (std::uint32_t k = 0; k < p.count; ++k) {
       const std::uint32_t v = from.ids_[p.first + k];
-      const auto [it, fresh] =
-          local_.try_emplace(kAdopted | v, static_cast<std::uint32_t>(pos_.size()));
-      if (fresh) {
-        pos_.push_back(from.pos_[v]);
-        col_.push_back(from.col_[v]);
-        tc_.push_back(from.tc_[v]);
-      }
-      ids_.push_back(it->second);
+      ids_.push_back(local_vertex(kAdopted | v, from.pos_[v], from.col_[v], from.tc_[v]));
     }
     Poly q = p;
     q.first = first;
