@@ -66,7 +66,8 @@ struct RenderOptions {
 
 void run_render(const RenderOptions& o) {
   // Fail before the expensive work when an output would be replaced or nothing can be drawn.
-  for (const auto* p : {&o.output, &o.stats, &o.export_vtp}) {
+  output::check_output_path(o.output, "-o", ".png", o.force);
+  for (const auto* p : {&o.stats, &o.export_vtp}) {
     if (!p->empty() && !o.force && std::filesystem::exists(*p)) {
       throw std::runtime_error(p->string() + ": exists (use --force to overwrite)");
     }

@@ -206,6 +206,20 @@ scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesys
   std::optional<density::DensitySpec> density;
   if (!args.density.empty()) density = density::parse_density(args.density);
   for (scene::ObjectSpec& o : parse_objects(args.objects)) scene.objects.push_back(std::move(o));
+  if (args.volumes.empty() && scene.volumes.empty()) {
+    // Options for volumes, with no volume: an error, not a picture without what they asked for.
+    const std::pair<const char*, bool> styling[] = {{"--iso", !args.isos.empty()},
+                                                    {"--slice", !args.slices.empty()},
+                                                    {"--density", density.has_value()},
+                                                    {"--field", !args.field.empty()},
+                                                    {"--volume-frame", !frame.empty()}};
+    for (const auto& [name, given] : styling) {
+      if (given) {
+        throw std::invalid_argument(std::string(name) +
+                                    " needs a volume: give --volume FILE (or a scene file with \"volumes\")");
+      }
+    }
+  }
   if (args.volumes.empty()) {
     for (std::size_t k = 0; k < scene.volumes.size(); ++k) {
       scene::VolumeSpec& v = scene.volumes[k];

@@ -89,7 +89,9 @@ scene::SceneStyle given_style(const SceneArgs& args);
 // (scene::parse_object) joins the file's objects. A level without a colour takes the palette's
 // colour of its place among every volume's (volume v's level k is the (v * levels + k)-th), so
 // that the same level of two volumes differs. Throws std::invalid_argument for a bad file
-// or bad --iso, --slice, --density, --object, --volume-frame or --size text.
+// or bad --iso, --slice, --density, --object, --volume-frame or --size text, and when --iso,
+// --slice, --density, --field or --volume-frame is given with no volume to style (no --volume
+// and none in the scene file).
 scene::SceneSpec read_scene_args(const SceneArgs& args, std::vector<std::filesystem::path>& dems);
 
 }  // namespace terravol::app::cli

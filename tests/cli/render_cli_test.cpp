@@ -286,6 +286,21 @@ TEST(RenderCli, BadArgumentsFailCleanlyWithOneLine) {
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --near-plane 1e9", "--near-plane");
   expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --tint purple", "--tint");
   expect_clean_failure(std::string(TERRAVOL_SOURCE_DIR) + "/missing.hgt --camera 45.5,6.5,3000,0,-10", "missing.hgt");
+  // Options for volumes with no volume: refused, not a picture without them.
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --iso 110", "--iso needs a volume");
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --slice agl=300", "--slice needs a volume");
+  expect_clean_failure(dem + " --camera 45.5,6.5,3000,0,-10 --volume-frame geographic", "--volume-frame needs a volume");
+}
+
+TEST(RenderCli, AnOutputNotNamedPngIsRefusedBeforeAnythingIsWritten) {
+  test::TempDir dir;
+  for (const char* name : {"view.jpg", "view", "view.png.txt"}) {
+    const auto out = dir.path() / name;
+    const auto r = run_terravol("render " + bundled_dem() + " --camera 45.5,6.5,3000,0,-10 -o " + out.string());
+    EXPECT_EQ(r.status, 1) << name << "\n" << r.err;
+    EXPECT_EQ(r.err, "terravol: -o " + out.string() + ": expected a .png file name\n");
+    EXPECT_FALSE(std::filesystem::exists(out)) << name;
+  }
 }
 
 TEST(RenderCli, BadObjectsFailCleanlyWithOneLine) {
