@@ -12,9 +12,12 @@
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <tbb/task_arena.h>
 
 #include "app/scene/ground_grid.h"
 #include "app/scene/mosaic_lattice.h"
@@ -25,6 +28,22 @@
 namespace terravol::app::render {
 
 namespace {
+
+// Runs `work` on this thread at the lowest priority (nice 19), its TBB loops on this thread
+// alone: the viewer's worker then gets the cores mostly while the frames leave them idle (the
+// main thread's traversal leaves one of llvmpipe's two), instead of taking one from the
+// rasterizer threads for the length of a slide. The slide arrives a few frames later; the
+// frames during it keep their pace. Nice 19, not SCHED_IDLE: a thread the frames wait for (a
+// scene freed before the next slide swaps) still advances, if slowly, when other processes
+// keep every core busy. On Linux the nice value is per thread. Lowering a priority needs no
+// privilege (raising it back does, so a thread is lowered only for what it does last); when
+// the system refuses, the work runs as it would have.
+template <class Work>
+auto at_lowest_priority(Work&& work) {
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  tbb::task_arena alone(1);
+  return alone.execute(std::forward<Work>(work));
+}
 
 using scene::Clock;
 using scene::ms_between;
@@ -231,12 +250,15 @@ void SceneRenderer::slide_copy(PreparedSlide& p) const {
   }
   const auto t1 = Clock::now();
   p.copy_ms = ms_between(t0, t1);
-  // A copy of the window: p.window stays for finish_slide's other way.
-  p.slid->slide(scene::SceneWindow(p.window));
-  const mrbsp::TerrainTree& tree = p.slid->tree();
-  if (p.vertices.rgba.size() != tree.positions().size() && !p.lattice.rgba.empty()) {
-    p.vertices = scene::vertex_shading(p.lattice, tree.merged_base(), tree.merged_colors());
-  }
+  // A copy of the window: p.window stays for finish_slide's other way. This thread ends with
+  // the slide, so its priority stays lowered.
+  at_lowest_priority([&] {
+    p.slid->slide(scene::SceneWindow(p.window));
+    const mrbsp::TerrainTree& tree = p.slid->tree();
+    if (p.vertices.rgba.size() != tree.positions().size() && !p.lattice.rgba.empty()) {
+      p.vertices = scene::vertex_shading(p.lattice, tree.merged_base(), tree.merged_colors());
+    }
+  });
   p.tree_ms = ms_since(t1);
 }
 
@@ -249,8 +271,10 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     std::swap(scene_, p.slid);
     if (retired_.valid()) retired_.wait();
     retired_ = std::async(std::launch::async, [old = std::move(p.slid)]() mutable {
-      old.reset();
-      return_freed_memory();
+      at_lowest_priority([&] {
+        old.reset();
+        return_freed_memory();
+      });
     });
     const double tree_ms = ms_since(t0);
     lattice_ = std::move(p.lattice);
@@ -339,8 +363,14 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          PreparedSlide p =
-              prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices);
+          // Reading and shading at the lowest priority (their own thread, waited for); the copy at
+          // this thread's own: it holds the scene's lock, which the next frame waits for, and an
+          // starved thread holding it would keep that frame waiting while anything else runs on
+          // the machine. The copy's slide at the lowest priority again (slide_copy).
+          PreparedSlide p = std::async(std::launch::async, [&] {
+                              return at_lowest_priority(
+                                  [&] { return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices); });
+                            }).get();
           slide_copy(p);
           return p;
         });
