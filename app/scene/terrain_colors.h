@@ -67,7 +67,7 @@ TerrainShading shade_terrain(int cells, std::span<const double> xs, std::span<co
 // The room kept after the tree's vertices for those appended later (merged pieces built when
 // first drawn, a frame's own faces), as a divisor of their count: the renderer's vertex arrays
 // keep count / kVertexRoom more, and so do vertex_shading's `shade` and `rgba`.
-inline constexpr std::size_t kVertexRoom = 16;
+inline constexpr std::size_t kVertexRoom = 8;
 
 // The attributes of the tree's vertices (TerrainTree::positions()): vertex v below the
 // lattice's sample count is lattice sample v and copies its attributes; the vertices from there

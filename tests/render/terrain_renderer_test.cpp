@@ -9,6 +9,7 @@
 
 #include "app/render/ordered_mapper.h"
 #include "app/render/terrain_renderer.h"
+#include "app/scene/terrain_colors.h"
 #include "mrbsp/color_boxes.h"
 #include "mrbsp/terrain_tree.h"
 #include "image_compare.h"
@@ -129,7 +130,8 @@ TEST(TerrainRenderer, ReleasedVerticesDrawOnlyTheBackgroundUntilNewOnesAreGiven)
       s.shading.rgba.push_back(scene::Rgba{255, 255, 255, 255});
     }
     renderer.replace_vertices(s.positions, s.shading);
-    EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 12);
+    // The twelve, and the room kept after them for vertices appended later.
+    EXPECT_EQ(renderer.scene()->GetNumberOfPoints(), 12 + 12 / static_cast<vtkIdType>(scene::kVertexRoom));
     std::vector<std::uint32_t> three = kFarThenNear;
     three.insert(three.end(), {8, 9, 10, 8, 10, 11});
     renderer.set_frame(frame_of(three));
