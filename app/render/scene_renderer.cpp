@@ -363,14 +363,14 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          // Reading and shading at the lowest priority (their own thread, waited for); the copy at
-          // this thread's own: it holds the scene's lock, which the next frame waits for, and an
-          // starved thread holding it would keep that frame waiting while anything else runs on
-          // the machine. The copy's slide at the lowest priority again (slide_copy).
-          PreparedSlide p = std::async(std::launch::async, [&] {
-                              return at_lowest_priority(
-                                  [&] { return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices); });
-                            }).get();
+          // Reading and shading at the lowest priority (their own thread, waited for); the
+          // copy at this thread's own: it holds the scene's lock, which the next frame waits
+          // for, and a starved thread holding it would keep that frame waiting while anything
+          // else runs on the machine. The copy's slide at the lowest priority again
+          // (slide_copy).
+          const auto read = [&] { return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices); };
+          PreparedSlide p =
+              std::async(std::launch::async, [&] { return at_lowest_priority(read); }).get();
           slide_copy(p);
           return p;
         });
