@@ -221,14 +221,18 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
     const std::lock_guard<std::mutex> lock(mosaic_mutex);
     p.window = scene::read_scene_window(mosaic, next, frame);
   }
-  const auto t1 = Clock::now();
-  if (shading) {
-    p.lattice = scene::shade_terrain(next.cells, p.window.xs, p.window.ys, p.window.z, p.window.heights, *shading);
-    if (terrain_vertices > 0) p.vertices = scene::vertex_shading(p.lattice, terrain_vertices, {});
-    p.shade_ms = ms_since(t1);
-  }
-  p.read_ms = ms_between(t0, t1);
+  p.read_ms = ms_since(t0);
+  if (shading) shade_slide(p, *shading, terrain_vertices);
   return p;
+}
+
+void SceneRenderer::shade_slide(PreparedSlide& p, const scene::ShadingOptions& shading,
+                                std::size_t terrain_vertices) {
+  const auto t0 = Clock::now();
+  const scene::SceneWindow& w = p.window;
+  p.lattice = scene::shade_terrain(w.window.cells, w.xs, w.ys, w.z, w.heights, shading);
+  if (terrain_vertices > 0) p.vertices = scene::vertex_shading(p.lattice, terrain_vertices, {});
+  p.shade_ms = ms_since(t0);
 }
 
 void SceneRenderer::slide_copy(PreparedSlide& p) const {
@@ -363,14 +367,15 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          // Reading and shading at the lowest priority (their own thread, waited for); the
-          // copy at this thread's own: it holds the scene's lock, which the next frame waits
-          // for, and a starved thread holding it would keep that frame waiting while anything
-          // else runs on the machine. The copy's slide at the lowest priority again
-          // (slide_copy).
-          const auto read = [&] { return prepare_slide(mosaic_, mosaic_mutex_, w, frame, shading, terrain_vertices); };
-          PreparedSlide p =
-              std::async(std::launch::async, [&] { return at_lowest_priority(read); }).get();
+          // The read and the copy at this thread's own priority, the shading (on a thread of
+          // its own, waited for) and the copy's slide (slide_copy) at the lowest. The read and
+          // the copy hold locks that frames wait for: the mosaic's (ground_height() beyond the
+          // window) and the scene's (every frame's preparation). A starved thread holding one
+          // kept such frames waiting for 70-235 ms while it decoded new tiles.
+          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame, std::nullopt, 0);
+          std::async(std::launch::async, [&] {
+            at_lowest_priority([&] { shade_slide(p, shading, terrain_vertices); });
+          }).get();
           slide_copy(p);
           return p;
         });

@@ -261,6 +261,10 @@ class SceneRenderer {
                                      const scene::WindowChoice& next, const io::SceneFrame& frame,
                                      const std::optional<scene::ShadingOptions>& shading,
                                      std::size_t terrain_vertices);
+  // prepare_slide()'s shading of the read window (and, with terrain_vertices > 0, of the
+  // vertices), apart.
+  static void shade_slide(PreparedSlide& prepared, const scene::ShadingOptions& shading,
+                          std::size_t terrain_vertices);
   // On the worker, after prepare_slide(): the scene copied (under scene_mutex_) and slid to
   // the prepared window, and the vertices' shading made for the slid tree.
   void slide_copy(PreparedSlide& prepared) const;
