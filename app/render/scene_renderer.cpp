@@ -196,8 +196,9 @@ double SceneRenderer::eye_height(const scene::CameraPose& pose, bool agl) const 
 }
 
 // Sliding (section 4.3), the same steps in both modes: next_window() decides, prepare_slide()
-// reads the moved window and shades it (on this thread, or on a worker with kAsynchronous),
-// finish_slide() slides the tree and replaces the renderer's vertices on this thread.
+// reads the moved window (on this thread, or on a worker with kAsynchronous, which also shades
+// it there: shade_slide()), finish_slide() slides the tree and replaces the renderer's vertices
+// on this thread.
 std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::CameraPose& pose) const {
   const scene::LatticePoint p = scene::lattice_point(mosaic_, pose.lat, pose.lon);
   const scene::WindowChoice& now = scene_->window();
@@ -207,14 +208,11 @@ std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::Camer
   return next;
 }
 
-// Reads `next` from the mosaic (under its lock) in `frame`; with `shading`, shades it too and,
-// with terrain_vertices > 0 (a tree without merged polygons, whose vertices are the lattice's
-// only), makes the vertices' shading. Touches nothing of the pipeline, so it may run
-// on a worker thread while the pipeline draws.
+// Reads `next` from the mosaic (under its lock) in `frame`. Touches nothing of the pipeline,
+// so it may run on a worker thread while the pipeline draws.
 SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
-                                                          const scene::WindowChoice& next, const io::SceneFrame& frame,
-                                                          const std::optional<scene::ShadingOptions>& shading,
-                                                          std::size_t terrain_vertices) {
+                                                          const scene::WindowChoice& next,
+                                                          const io::SceneFrame& frame) {
   PreparedSlide p;
   const auto t0 = Clock::now();
   {
@@ -222,7 +220,6 @@ SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosa
     p.window = scene::read_scene_window(mosaic, next, frame);
   }
   p.read_ms = ms_since(t0);
-  if (shading) shade_slide(p, *shading, terrain_vertices);
   return p;
 }
 
@@ -343,7 +340,7 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
   bool slid = false;
   if (options_.sliding == Sliding::kSynchronous) {
     if (const auto next = auto_slide_ ? next_window(pose) : std::nullopt) {
-      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame(), std::nullopt, 0));
+      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame()));
       slid = true;
     }
   } else {
@@ -372,7 +369,7 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
           // the copy hold locks that frames wait for: the mosaic's (ground_height() beyond the
           // window) and the scene's (every frame's preparation). A starved thread holding one
           // kept such frames waiting for 70-235 ms while it decoded new tiles.
-          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame, std::nullopt, 0);
+          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame);
           std::async(std::launch::async, [&] {
             at_lowest_priority([&] { shade_slide(p, shading, terrain_vertices); });
           }).get();

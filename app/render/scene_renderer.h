@@ -258,15 +258,14 @@ class SceneRenderer {
   void slide(const scene::CameraPose& pose, FrameStats& stats);
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
   static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
-                                     const scene::WindowChoice& next, const io::SceneFrame& frame,
-                                     const std::optional<scene::ShadingOptions>& shading,
-                                     std::size_t terrain_vertices);
-  // prepare_slide()'s shading of the read window (and, with terrain_vertices > 0, of the
-  // vertices), apart.
+                                     const scene::WindowChoice& next, const io::SceneFrame& frame);
+  // The read window's shading and, with terrain_vertices > 0 (a tree without merged polygons,
+  // whose vertices are the lattice's only), the vertices' shading; on the worker.
   static void shade_slide(PreparedSlide& prepared, const scene::ShadingOptions& shading,
                           std::size_t terrain_vertices);
-  // On the worker, after prepare_slide(): the scene copied (under scene_mutex_) and slid to
-  // the prepared window, and the vertices' shading made for the slid tree.
+  // On the worker, after prepare_slide() and shade_slide(): the scene copied (under
+  // scene_mutex_) and slid to the prepared window, and the vertices' shading made for the slid
+  // tree.
   void slide_copy(PreparedSlide& prepared) const;
   void finish_slide(PreparedSlide&& prepared);
 
