@@ -124,7 +124,6 @@ Mosaic Mosaic::open(const std::vector<std::filesystem::path>& inputs, const Read
     t.cols = g.cols;
     t.georef = g.georef;
     m.tiles_.push_back(t);
-    ++m.loads_;
     m.cache_insert(m.tiles_.size() - 1, std::move(g));
   }
 
@@ -202,26 +201,37 @@ std::size_t Mosaic::gap_samples() const {
   return n;
 }
 
-const Grid& Mosaic::cache_insert(std::size_t tile, Grid grid) const {
-  while (cache_.size() >= cache_capacity_) cache_.pop_back();
-  cache_.push_front({tile, std::make_unique<Grid>(std::move(grid))});
-  return *cache_.front().grid;
+std::shared_ptr<const Grid> Mosaic::cache_insert(std::size_t tile, Grid grid) const {
+  auto fresh = std::make_shared<const Grid>(std::move(grid));
+  const std::lock_guard<std::mutex> lock(cache_->mutex);
+  ++cache_->loads;
+  for (auto it = cache_->tiles.begin(); it != cache_->tiles.end(); ++it) {
+    if (it->tile == tile) return it->grid;  // another thread's decode came first
+  }
+  while (cache_->tiles.size() >= cache_capacity_) cache_->tiles.pop_back();
+  cache_->tiles.push_front({tile, std::move(fresh)});
+  return cache_->tiles.front().grid;
 }
 
-const Grid& Mosaic::tile_grid(std::size_t i) const {
-  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
-    if (it->tile == i) {
-      cache_.splice(cache_.begin(), cache_, it);
-      return *cache_.front().grid;
+std::shared_ptr<const Grid> Mosaic::cached(std::size_t tile) const {
+  const std::lock_guard<std::mutex> lock(cache_->mutex);
+  for (auto it = cache_->tiles.begin(); it != cache_->tiles.end(); ++it) {
+    if (it->tile == tile) {
+      cache_->tiles.splice(cache_->tiles.begin(), cache_->tiles, it);
+      return it->grid;
     }
   }
-  Grid g = load_tile(i);
-  ++loads_;
-  return cache_insert(i, std::move(g));
+  return nullptr;
 }
 
-bool Mosaic::cached(std::size_t i) const {
-  return std::any_of(cache_.begin(), cache_.end(), [&](const Cached& c) { return c.tile == i; });
+std::shared_ptr<const Grid> Mosaic::tile_grid(std::size_t i) const {
+  if (auto g = cached(i)) return g;
+  return cache_insert(i, load_tile(i));  // decoded outside the cache's lock
+}
+
+std::size_t Mosaic::loads() const {
+  const std::lock_guard<std::mutex> lock(cache_->mutex);
+  return cache_->loads;
 }
 
 Grid Mosaic::load_tile(std::size_t i) const {
@@ -237,6 +247,14 @@ Grid Mosaic::load_tile(std::size_t i) const {
 }
 
 Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
+  return *read_window(row0, col0, n_rows, n_cols, true);
+}
+
+std::optional<Grid> Mosaic::read_cached_window(int row0, int col0, int n_rows, int n_cols) const {
+  return read_window(row0, col0, n_rows, n_cols, false);
+}
+
+std::optional<Grid> Mosaic::read_window(int row0, int col0, int n_rows, int n_cols, bool may_load) const {
   check_dimensions("mosaic window", n_rows, n_cols, kMaxSamples);
   Grid out;
   out.georef = georef_;
@@ -279,10 +297,14 @@ Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
   const std::size_t batch = std::max<std::size_t>(1, cache_capacity_);
   for (std::size_t b0 = 0; b0 < parts.size(); b0 += batch) {
     const std::size_t b1 = std::min(parts.size(), b0 + batch);
+    // The batch's tiles held here while they are copied, whatever other threads evict.
+    std::vector<std::shared_ptr<const Grid>> kept(b1 - b0);
     std::vector<std::optional<Grid>> fresh(b1 - b0);
     std::vector<std::size_t> todo;
-    for (std::size_t k = b0; k < b1; ++k)
-      if (parts[k].sure && !cached(parts[k].tile)) todo.push_back(k);
+    for (std::size_t k = b0; k < b1; ++k) {
+      kept[k - b0] = cached(parts[k].tile);
+      if (parts[k].sure && !kept[k - b0] && may_load) todo.push_back(k);
+    }
     // A tile that fails is reported as the serial read would: the first in tile order.
     std::vector<std::exception_ptr> failed(todo.size());
     tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t q) {
@@ -309,9 +331,14 @@ Grid Mosaic::read_window(int row0, int col0, int n_rows, int n_cols) const {
         }
       }
       if (!needed) continue;
-      std::optional<Grid>& f = fresh[k - b0];
-      if (f) ++loads_;
-      const Grid& g = f ? cache_insert(p.tile, std::move(*f)) : tile_grid(p.tile);
+      std::shared_ptr<const Grid>& h = kept[k - b0];
+      if (std::optional<Grid>& f = fresh[k - b0]) {
+        h = cache_insert(p.tile, std::move(*f));
+      } else if (!h) {
+        if (!may_load) return std::nullopt;
+        h = tile_grid(p.tile);
+      }
+      const Grid& g = *h;
       if (out.format.empty()) {
         out.format = g.format;
         out.vertical_datum = g.vertical_datum;

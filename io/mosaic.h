@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <list>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,8 +42,11 @@ struct MosaicGap {
 // .hgt.zip records (compressed.h, recorded_size), without reading it; other tiles (.hgt.bz2:
 // bzip2 records no size) are read once at open() to learn their extent and kept in the cache. Decoded tiles live in a cache of at most
 // `cache_tiles` tiles, so memory is bounded by the window and the cache, not by the number
-// of input files. Not thread-safe (the cache is shared); read_window decodes the tiles it
-// needs in parallel itself.
+// of input files. Reads are safe on any number of threads at once: the cache has its own lock,
+// held only to look a tile up or put it in, never while a tile decodes (a frame's ground
+// height need not wait for a worker's decode), and a caller keeps the tiles it reads alive
+// while another thread's read evicts them. Two threads that miss the same tile both decode it.
+// read_window decodes the tiles it needs in parallel itself.
 class Mosaic {
  public:
   // inputs: files and directories (a directory contributes every file in it whose name has a
@@ -62,11 +67,15 @@ class Mosaic {
   // may extend past the mosaic (those samples are kOutside). Loads only the tiles it
   // overlaps. Throws FormatError for an empty or absurd window and for tiles that fail to load.
   Grid read_window(int row0, int col0, int n_rows, int n_cols) const;
+  // The same window when every tile it needs is in the cache, without loading any; nullopt when
+  // one is not (for a caller that must not wait for a decode). Throws as read_window does for
+  // an empty or absurd window.
+  std::optional<Grid> read_cached_window(int row0, int col0, int n_rows, int n_cols) const;
 
   // Tile i decoded (geographic, voids marked), from the cache or loaded now.
-  const Grid& tile_grid(std::size_t i) const;
+  std::shared_ptr<const Grid> tile_grid(std::size_t i) const;
   // How many tile loads have happened (cache misses), for tests and stats.
-  std::size_t loads() const { return loads_; }
+  std::size_t loads() const;
 
  private:
   Mosaic() = default;
@@ -78,12 +87,19 @@ class Mosaic {
   std::size_t cache_capacity_ = 4;
   struct Cached {
     std::size_t tile;
-    std::unique_ptr<Grid> grid;
+    std::shared_ptr<const Grid> grid;
   };
-  mutable std::list<Cached> cache_;  // most recently used first
-  mutable std::size_t loads_ = 0;
-  const Grid& cache_insert(std::size_t tile, Grid grid) const;
-  bool cached(std::size_t tile) const;
+  struct Cache {
+    std::mutex mutex;          // guards the two below
+    std::list<Cached> tiles;   // most recently used first
+    std::size_t loads = 0;
+  };
+  std::unique_ptr<Cache> cache_ = std::make_unique<Cache>();  // behind a pointer: Mosaic moves
+  // A freshly loaded tile counted and put in (or the copy another thread put in meanwhile).
+  std::shared_ptr<const Grid> cache_insert(std::size_t tile, Grid grid) const;
+  // The cached tile, made most recently used, or null (nothing loaded).
+  std::shared_ptr<const Grid> cached(std::size_t tile) const;
+  std::optional<Grid> read_window(int row0, int col0, int n_rows, int n_cols, bool may_load) const;
   // Tile i read and checked against the extent its name gave (no cache: safe on any thread).
   Grid load_tile(std::size_t i) const;
 };

@@ -208,17 +208,13 @@ std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::Camer
   return next;
 }
 
-// Reads `next` from the mosaic (under its lock) in `frame`. Touches nothing of the pipeline,
-// so it may run on a worker thread while the pipeline draws.
-SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
-                                                          const scene::WindowChoice& next,
+// Reads `next` from the mosaic in `frame`. Touches nothing of the pipeline, so it may run on a
+// worker thread while the pipeline draws.
+SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, const scene::WindowChoice& next,
                                                           const io::SceneFrame& frame) {
   PreparedSlide p;
   const auto t0 = Clock::now();
-  {
-    const std::lock_guard<std::mutex> lock(mosaic_mutex);
-    p.window = scene::read_scene_window(mosaic, next, frame);
-  }
+  p.window = scene::read_scene_window(mosaic, next, frame);
   p.read_ms = ms_since(t0);
   return p;
 }
@@ -272,11 +268,13 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     std::swap(scene_, p.slid);
     if (retired_.valid()) retired_.wait();
     retired_ = std::async(std::launch::async, [old = std::move(p.slid)]() mutable {
-      at_lowest_priority([&] {
-        old.reset();
-        return_freed_memory();
-      });
+      at_lowest_priority([&] { old.reset(); });
     });
+    // The freed pages go back to the system when the viewer rests (return_memory()), not
+    // here: malloc_trim walks every arena under its lock, and trimming beside the landing frame
+    // (which allocates the low alternatives it builds) made that frame 30-70 ms slower, at the
+    // lowest priority or at normal.
+    memory_to_return_ = true;
     const double tree_ms = ms_since(t0);
     lattice_ = std::move(p.lattice);
     const auto t1 = Clock::now();
@@ -340,7 +338,7 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
   bool slid = false;
   if (options_.sliding == Sliding::kSynchronous) {
     if (const auto next = auto_slide_ ? next_window(pose) : std::nullopt) {
-      finish_slide(prepare_slide(mosaic_, mosaic_mutex_, *next, scene_->frame()));
+      finish_slide(prepare_slide(mosaic_, *next, scene_->frame()));
       slid = true;
     }
   } else {
@@ -364,14 +362,18 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          // The read and the copy at this thread's own priority, the shading (on a thread of
-          // its own, waited for) and the copy's slide (slide_copy) at the lowest. The read and
-          // the copy hold locks that frames wait for: the mosaic's (ground_height() beyond the
-          // window) and the scene's (every frame's preparation). A starved thread holding one
-          // kept such frames waiting for 70-235 ms while it decoded new tiles.
-          PreparedSlide p = prepare_slide(mosaic_, mosaic_mutex_, w, frame);
-          std::async(std::launch::async, [&] {
-            at_lowest_priority([&] { shade_slide(p, shading, terrain_vertices); });
+          // The read and the shading at the lowest priority (on a thread of their own, waited
+          // for), the copy at this thread's own, its slide (slide_copy) at the lowest again. The
+          // copy holds the scene's lock, which every frame's preparation waits for: a starved
+          // thread holding it would stall frames. The read holds no lock a frame waits for
+          // (ground_height() beyond the window does not wait for its decode; an earlier read
+          // under one lock of the mosaic stalled such frames for 70-235 ms).
+          PreparedSlide p = std::async(std::launch::async, [&] {
+            return at_lowest_priority([&] {
+              PreparedSlide read = prepare_slide(mosaic_, w, frame);
+              shade_slide(read, shading, terrain_vertices);
+              return read;
+            });
           }).get();
           slide_copy(p);
           return p;
@@ -510,6 +512,14 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   return volumes_.figures();
 }
 
+bool SceneRenderer::memory_to_return() const { return memory_to_return_ && !pending_.valid(); }
+
+void SceneRenderer::return_memory() {
+  if (retired_.valid()) retired_.wait();
+  return_freed_memory();
+  memory_to_return_ = false;
+}
+
 mrbsp::MergeStats SceneRenderer::tidy() {
   const std::lock_guard<std::mutex> lock(scene_mutex_);
   if (scene_->tree().merge_stats().worn_slots == 0) return scene_->tree().merge_stats();
@@ -522,11 +532,7 @@ volume::LinkProfile SceneRenderer::link_profile(const volume::Transmitter& tx, d
                                                 double rx_height_agl, const volume::RfOptions& options) const {
   const volume::DemExtent area{std::min(tx.lat, rx_lat), std::max(tx.lat, rx_lat), std::min(tx.lon, rx_lon),
                                std::max(tx.lon, rx_lon)};
-  volume::RfWindow window;
-  {
-    const std::lock_guard<std::mutex> lock(mosaic_mutex_);
-    window = volume::read_rf_window(mosaic_, area);
-  }
+  const volume::RfWindow window = volume::read_rf_window(mosaic_, area);
   return volume::link_profile(window.grid, tx, rx_lat, rx_lon, rx_height_agl, options);
 }
 
@@ -572,7 +578,15 @@ double SceneRenderer::ground_height(double lat, double lon) const {
   const scene::WindowBounds b = scene_->bounds();
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
   const io::Georef& g = mosaic_.georef();
-  const std::lock_guard<std::mutex> lock(mosaic_mutex_);
+  if (pending_.valid()) {
+    // A slide is under way: its worker may be decoding the tiles here at the lowest priority.
+    // A frame does not wait for that: until they are decoded, the ground of the window's
+    // nearest point (beyond the window, the eye sees only its walls and what lies outside).
+    if (const auto near = scene::GroundGrid::cached(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)) {
+      return (*near)(lat, lon);
+    }
+    return scene_->ground_height(std::clamp(lat, b.south, b.north), std::clamp(lon, b.west, b.east));
+  }
   return scene::GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
 }
 

@@ -223,6 +223,12 @@ class SceneRenderer {
   // the renderer's vertices up to date; the image does not change, later frames draw fewer
   // pieces. For idle moments (terravol view between keys). Returns the tree's figures.
   mrbsp::MergeStats tidy();
+  // Whether slides (kAsynchronous) have freed memory that return_memory() would give back to
+  // the system: true after a slide lands, until return_memory(); false while a slide is under
+  // way. return_memory() runs malloc_trim (glibc; elsewhere nothing), 2-24 ms on this thread:
+  // for a viewer at rest (a trim beside the frames slows them; see finish_slide).
+  bool memory_to_return() const;
+  void return_memory();
   // The objects on the terrain (set_fixed_level for benchmarks and tests; takes effect at the
   // next prepare()).
   scene::ObjectLayer& objects() { return objects_; }
@@ -257,8 +263,8 @@ class SceneRenderer {
   };
   void slide(const scene::CameraPose& pose, FrameStats& stats);
   std::optional<scene::WindowChoice> next_window(const scene::CameraPose& pose) const;
-  static PreparedSlide prepare_slide(const io::Mosaic& mosaic, std::mutex& mosaic_mutex,
-                                     const scene::WindowChoice& next, const io::SceneFrame& frame);
+  static PreparedSlide prepare_slide(const io::Mosaic& mosaic, const scene::WindowChoice& next,
+                                     const io::SceneFrame& frame);
   // The read window's shading and, with terrain_vertices > 0 (a tree without merged polygons,
   // whose vertices are the lattice's only), the vertices' shading; on the worker.
   static void shade_slide(PreparedSlide& prepared, const scene::ShadingOptions& shading,
@@ -269,10 +275,7 @@ class SceneRenderer {
   void slide_copy(PreparedSlide& prepared) const;
   void finish_slide(PreparedSlide&& prepared);
 
-  io::Mosaic mosaic_;
-  // The mosaic's tile cache serves one reader at a time: a read ahead on the worker thread and
-  // ground_height() outside the window take turns.
-  mutable std::mutex mosaic_mutex_;
+  io::Mosaic mosaic_;  // read by the worker and this thread at once (its cache has a lock)
   RenderSettings settings_;
   SceneOptions options_;
   int levels_ = 0;
@@ -286,6 +289,7 @@ class SceneRenderer {
   double far_plane_ = 0;                       // kTiler: of the prepared frame
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
+  bool memory_to_return_ = false;
   density::RefineOptions density_options_;
   std::vector<mrbsp::ColorBox> boxes_;  // the density's cells of the last frame
   bool auto_slide_ = true;

@@ -2,24 +2,41 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "io/void_fill.h"
 
 namespace terravol::app::scene {
 
-GroundGrid::GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east) {
+GroundGrid::Span GroundGrid::span(const io::Mosaic& mosaic, double south, double north, double west, double east) {
   const io::Georef& g = mosaic.georef();
   const int r0 = static_cast<int>(std::floor((g.y0 - north) / g.dy)) - 2;
   const int r1 = static_cast<int>(std::ceil((g.y0 - south) / g.dy)) + 2;
   const int c0 = static_cast<int>(std::floor((west - g.x0) / g.dx)) - 2;
   const int c1 = static_cast<int>(std::ceil((east - g.x0) / g.dx)) + 2;
-  const int rows = std::clamp(r1 - r0 + 1, 2, 20000), cols = std::clamp(c1 - c0 + 1, 2, 20000);
-  grid_ = mosaic.read_window(r0, c0, rows, cols);
+  return {r0, c0, std::clamp(r1 - r0 + 1, 2, 20000), std::clamp(c1 - c0 + 1, 2, 20000)};
+}
+
+GroundGrid::GroundGrid(const io::Mosaic& mosaic, const Span& s, io::Grid grid) : grid_(std::move(grid)) {
+  const io::Georef& g = mosaic.georef();
   io::fill_voids(grid_);
-  lat0_ = g.y0 - r0 * g.dy;
-  lon0_ = g.x0 + c0 * g.dx;
+  lat0_ = g.y0 - s.r0 * g.dy;
+  lon0_ = g.x0 + s.c0 * g.dx;
   dlat_ = g.dy;
   dlon_ = g.dx;
+}
+
+GroundGrid::GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east) {
+  const Span s = span(mosaic, south, north, west, east);
+  *this = GroundGrid(mosaic, s, mosaic.read_window(s.r0, s.c0, s.rows, s.cols));
+}
+
+std::optional<GroundGrid> GroundGrid::cached(const io::Mosaic& mosaic, double south, double north, double west,
+                                             double east) {
+  const Span s = span(mosaic, south, north, west, east);
+  std::optional<io::Grid> grid = mosaic.read_cached_window(s.r0, s.c0, s.rows, s.cols);
+  if (!grid) return std::nullopt;
+  return GroundGrid(mosaic, s, std::move(*grid));
 }
 
 double GroundGrid::operator()(double lat, double lon) const {

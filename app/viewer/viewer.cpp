@@ -786,6 +786,8 @@ void Viewer::tick() {
              pipeline_->terrain().tree().merge_stats().worn_slots > 0) {
     tidied_slots_ += pipeline_->tidy().rebuilt_slots;
     dirty_ = true;  // the same image, from fewer pieces
+  } else if (held_.empty() && now - last_key_ >= kTidyAfter && pipeline_->memory_to_return()) {
+    pipeline_->return_memory();  // the pages slides freed, given back at rest
   }
 }
 

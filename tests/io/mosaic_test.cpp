@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <random>
+#include <thread>
 #include <vector>
 
 #include "compress.h"
@@ -104,7 +106,7 @@ TEST(Mosaic, WindowOverFourTilesDecodedTogetherHoldsEachTilesOwnSamples) {
   std::vector<char> done(static_cast<std::size_t>(rows) * cols, 0);
   for (std::size_t i = 0; i < one_by_one.tiles().size(); ++i) {
     const MosaicTile& t = one_by_one.tiles()[i];
-    const Grid& g = one_by_one.tile_grid(i);
+    const Grid& g = *one_by_one.tile_grid(i);
     for (int r = std::max(row0, t.row0); r < std::min(row0 + rows, t.row0 + t.rows); ++r)
       for (int c = std::max(col0, t.col0); c < std::min(col0 + cols, t.col0 + t.cols); ++c) {
         const std::size_t o = static_cast<std::size_t>(r - row0) * cols + (c - col0);
@@ -116,6 +118,54 @@ TEST(Mosaic, WindowOverFourTilesDecodedTogetherHoldsEachTilesOwnSamples) {
   EXPECT_EQ(std::count(done.begin(), done.end(), 1), static_cast<long>(rows) * cols);
   together.read_window(row0, col0, rows, cols);
   EXPECT_EQ(together.loads(), 4u) << "the second read comes from the cache";
+}
+
+TEST(Mosaic, ACachedWindowReadDecodesNothingAndGivesWhatTheReadGives) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w, 7.0f);
+  const Mosaic m = Mosaic::open({dir.path()}, {}, 2);
+  EXPECT_FALSE(m.read_cached_window(1100, 1150, 200, 100)) << "nothing is cached yet";
+  EXPECT_EQ(m.loads(), 0u);
+  m.read_window(10, 10, 64, 64);  // the north-west tile alone
+  EXPECT_EQ(m.loads(), 1u);
+  EXPECT_FALSE(m.read_cached_window(10, 1150, 64, 100)) << "the north-east tile is not cached";
+  EXPECT_EQ(m.loads(), 1u);
+  const std::optional<Grid> cached = m.read_cached_window(20, 30, 64, 64);
+  ASSERT_TRUE(cached);
+  const Grid read = m.read_window(20, 30, 64, 64);
+  EXPECT_EQ(cached->heights, read.heights);
+  EXPECT_EQ(cached->mask, read.mask);
+  EXPECT_EQ(m.loads(), 1u);
+}
+
+// Two threads read seeded windows at once through a one-tile cache, so that each keeps
+// evicting the tile the other is copying; each window must hold a serial read's samples.
+TEST(Mosaic, WindowsReadOnTwoThreadsAtOnceHoldTheSerialReadsSamples) {
+  test::TempDir dir;
+  for (int s : {44, 45})
+    for (int w : {-72, -71}) write_tile(dir.path(), s, w, 7.0f);
+  const Mosaic shared = Mosaic::open({dir.path()}, {}, 1);
+  const Mosaic serial = Mosaic::open({dir.path()}, {}, 4);
+  struct Window {
+    int row0, col0;
+  };
+  std::vector<Window> windows;
+  std::mt19937 rng(20261207);
+  std::uniform_int_distribution<int> at(0, 2400 - 40);
+  for (int k = 0; k < 24; ++k) windows.push_back({at(rng), at(rng)});
+  std::vector<Grid> got(windows.size());
+  auto read = [&](std::size_t first) {
+    for (std::size_t k = first; k < windows.size(); k += 2) got[k] = shared.read_window(windows[k].row0, windows[k].col0, 40, 40);
+  };
+  std::thread other(read, 1);
+  read(0);
+  other.join();
+  for (std::size_t k = 0; k < windows.size(); ++k) {
+    const Grid want = serial.read_window(windows[k].row0, windows[k].col0, 40, 40);
+    EXPECT_EQ(got[k].heights, want.heights) << "window " << k;
+    EXPECT_EQ(got[k].mask, want.mask) << "window " << k;
+  }
 }
 
 TEST(Mosaic, WindowNeedingMoreTilesThanTheCacheReadsEachOnce) {

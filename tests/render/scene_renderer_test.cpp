@@ -116,6 +116,10 @@ TEST(SceneRenderer, AReadAheadSlideLandsAtALaterFrameAsTheSynchronousOneDoes) {
   EXPECT_GT(async.last_slide().read_ms, 0.0);
   EXPECT_GT(async.last_slide().worker_tree_ms, 0.0) << "the tree slid on the worker, on a copy of the scene";
   EXPECT_EQ(sync.last_slide().worker_tree_ms, 0.0) << "the synchronous slide is made on the calling thread";
+  EXPECT_TRUE(async.memory_to_return()) << "the old scene's pages wait for the viewer to rest";
+  EXPECT_FALSE(sync.memory_to_return()) << "the synchronous slide gives them back itself";
+  async.return_memory();
+  EXPECT_FALSE(async.memory_to_return());
   sync.render(kNorth, true, 45.0, {});
   expect_same_slide(sync, async);
 }
