@@ -29,20 +29,33 @@ namespace terravol::app::render {
 
 namespace {
 
-// Runs `work` on this thread at the lowest priority (nice 19), its TBB loops on this thread
-// alone: the viewer's worker then gets the cores mostly while the frames leave them idle (the
+// Runs `work` on this thread at nice `nice` (at_lowest_priority: 19), its TBB loops on this
+// thread alone: the viewer's worker then gets the cores mostly while the frames leave them idle (the
 // main thread's traversal leaves one of llvmpipe's two), instead of taking one from the
 // rasterizer threads for the length of a slide. The slide arrives a few frames later; the
 // frames during it keep their pace. Nice 19, not SCHED_IDLE: a thread the frames wait for (a
 // scene freed before the next slide swaps) still advances, if slowly, when other processes
 // keep every core busy. On Linux the nice value is per thread. Lowering a priority needs no
 // privilege (raising it back does, so a thread is lowered only for what it does last); when
-// the system refuses, the work runs as it would have.
+// the system refuses, the work runs as it would have. Once lowered, a thread stays so.
 template <class Work>
-auto at_lowest_priority(Work&& work) {
-  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+auto at_priority(int nice, Work&& work) {
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice);
   tbb::task_arena alone(1);
   return alone.execute(std::forward<Work>(work));
+}
+
+// The slide worker's read of the moved window (decoding new tiles: about 650 ms of CPU for two
+// of Utah's .sdf.bz2) at nice 10, between the frames' 0 and the shading's 19: at 19 it starved
+// while the frames kept both cores busy (the benchmark's flight left the window before a slide
+// landed, and in one run of 1000 frames none landed); at 10 it lands about as soon as at 0
+// (0.7-0.8 s a slide against 0.5-0.8) and takes less from the frames (measured: docs/
+// architecture.md, the viewer's slides).
+constexpr int kReadNice = 10;
+
+template <class Work>
+auto at_lowest_priority(Work&& work) {
+  return at_priority(19, std::forward<Work>(work));
 }
 
 using scene::Clock;
@@ -267,13 +280,14 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
     // scene is freed on a worker (its small BSPs are tens of thousands of allocations).
     std::swap(scene_, p.slid);
     if (retired_.valid()) retired_.wait();
-    retired_ = std::async(std::launch::async, [old = std::move(p.slid)]() mutable {
+    retired_ = std::async(std::launch::async, [this, old = std::move(p.slid)]() mutable {
       at_lowest_priority([&] { old.reset(); });
+      freed_ = true;
     });
-    // The freed pages go back to the system when the viewer rests (return_memory()), not
-    // here: malloc_trim walks every arena under its lock, and trimming beside the landing frame
-    // (which allocates the low alternatives it builds) made that frame 30-70 ms slower, at the
-    // lowest priority or at normal.
+    // The freed pages go back to the system at the next slide's start or when the viewer rests
+    // (return_memory()), not here: malloc_trim walks every arena under its lock, and trimming
+    // beside the landing frame (which allocates the low alternatives it builds) made that frame
+    // 30-70 ms slower, at the lowest priority or at normal.
     memory_to_return_ = true;
     const double tree_ms = ms_since(t0);
     lattice_ = std::move(p.lattice);
@@ -362,18 +376,19 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
         const std::size_t terrain_vertices = volumes_.size() == 0 && objects_.size() == 0 ? scene_->tree().merged_base() : 0;
         pending_ = std::async(std::launch::async, [this, w = *next, frame = scene_->frame(),
                                                    shading = options_.shading, terrain_vertices] {
-          // The read and the shading at the lowest priority (on a thread of their own, waited
-          // for), the copy at this thread's own, its slide (slide_copy) at the lowest again. The
-          // copy holds the scene's lock, which every frame's preparation waits for: a starved
-          // thread holding it would stall frames. The read holds no lock a frame waits for
-          // (ground_height() beyond the window does not wait for its decode; an earlier read
-          // under one lock of the mosaic stalled such frames for 70-235 ms).
+          // The pages the last landing freed, given back while the frames are quiet (a few ms;
+          // without it a flight that never rests holds 120-320 MB more).
+          if (freed_.exchange(false)) return_freed_memory();
+          // The read at nice kReadNice and the shading at the lowest priority (on a thread of
+          // their own, waited for), the copy at this thread's own, its slide (slide_copy) at the
+          // lowest again. The copy holds the scene's lock, which every frame's preparation waits
+          // for: a starved thread holding it would stall frames. The read holds no lock a frame
+          // waits for (ground_height() beyond the window does not wait for its decode; an
+          // earlier read under one lock of the mosaic stalled such frames for 70-235 ms).
           PreparedSlide p = std::async(std::launch::async, [&] {
-            return at_lowest_priority([&] {
-              PreparedSlide read = prepare_slide(mosaic_, w, frame);
-              shade_slide(read, shading, terrain_vertices);
-              return read;
-            });
+            PreparedSlide read = at_priority(kReadNice, [&] { return prepare_slide(mosaic_, w, frame); });
+            at_lowest_priority([&] { shade_slide(read, shading, terrain_vertices); });
+            return read;
           }).get();
           slide_copy(p);
           return p;
@@ -517,6 +532,7 @@ bool SceneRenderer::memory_to_return() const { return memory_to_return_ && !pend
 void SceneRenderer::return_memory() {
   if (retired_.valid()) retired_.wait();
   return_freed_memory();
+  freed_ = false;
   memory_to_return_ = false;
 }
 

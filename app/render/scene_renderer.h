@@ -8,6 +8,7 @@
 // same code.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <future>
@@ -225,8 +226,9 @@ class SceneRenderer {
   mrbsp::MergeStats tidy();
   // Whether slides (kAsynchronous) have freed memory that return_memory() would give back to
   // the system: true after a slide lands, until return_memory(); false while a slide is under
-  // way. return_memory() runs malloc_trim (glibc; elsewhere nothing), 2-24 ms on this thread:
-  // for a viewer at rest (a trim beside the frames slows them; see finish_slide).
+  // way (its worker gives back at its start what the landing before freed). return_memory()
+  // runs malloc_trim (glibc; elsewhere nothing), 2-24 ms on this thread: for a viewer at rest
+  // (a trim beside the landing frame slows it; see finish_slide).
   bool memory_to_return() const;
   void return_memory();
   // The objects on the terrain (set_fixed_level for benchmarks and tests; takes effect at the
@@ -290,6 +292,7 @@ class SceneRenderer {
   mrbsp::Frame frame_;
   mrbsp::Camera camera_;
   bool memory_to_return_ = false;
+  std::atomic<bool> freed_{false};  // the retired scene freed, its pages not yet given back
   density::RefineOptions density_options_;
   std::vector<mrbsp::ColorBox> boxes_;  // the density's cells of the last frame
   bool auto_slide_ = true;
