@@ -254,7 +254,8 @@ std::optional<Grid> Mosaic::read_cached_window(int row0, int col0, int n_rows, i
   return read_window(row0, col0, n_rows, n_cols, false);
 }
 
-std::optional<Grid> Mosaic::read_window(int row0, int col0, int n_rows, int n_cols, bool may_load) const {
+std::optional<Grid> Mosaic::read_window(int row0, int col0, int n_rows, int n_cols,
+                                        bool may_load) const {
   check_dimensions("mosaic window", n_rows, n_cols, kMaxSamples);
   Grid out;
   out.georef = georef_;

@@ -40,13 +40,13 @@ struct MosaicGap {
 // Laziness: open() learns each tile's extent from its name (SRTM N44W072, SDF 40_41_111_112,
 // compressed or not) and, for .hgt, its size on disk or the size a .hgt.gz, .hgt.xz or
 // .hgt.zip records (compressed.h, recorded_size), without reading it; other tiles (.hgt.bz2:
-// bzip2 records no size) are read once at open() to learn their extent and kept in the cache. Decoded tiles live in a cache of at most
-// `cache_tiles` tiles, so memory is bounded by the window and the cache, not by the number
-// of input files. Reads are safe on any number of threads at once: the cache has its own lock,
-// held only to look a tile up or put it in, never while a tile decodes (a frame's ground
-// height need not wait for a worker's decode), and a caller keeps the tiles it reads alive
-// while another thread's read evicts them. Two threads that miss the same tile both decode it.
-// read_window decodes the tiles it needs in parallel itself.
+// bzip2 records no size) are read once at open() to learn their extent and kept in the cache.
+// Decoded tiles live in a cache of at most `cache_tiles` tiles, so memory is bounded by the window
+// and the cache, not by the number of input files. Reads are safe on any number of threads at once:
+// the cache has its own lock, held only to look a tile up or put it in, never while a tile decodes
+// (a reader of cached tiles need not wait for another thread's decode), and a caller keeps the
+// tiles it reads alive while another thread's read evicts them. Two threads that miss the same tile
+// both decode it. read_window decodes the tiles it needs in parallel itself.
 class Mosaic {
  public:
   // inputs: files and directories (a directory contributes every file in it whose name has a
@@ -90,8 +90,8 @@ class Mosaic {
     std::shared_ptr<const Grid> grid;
   };
   struct Cache {
-    std::mutex mutex;          // guards the two below
-    std::list<Cached> tiles;   // most recently used first
+    std::mutex mutex;         // guards the two below
+    std::list<Cached> tiles;  // most recently used first
     std::size_t loads = 0;
   };
   std::unique_ptr<Cache> cache_ = std::make_unique<Cache>();  // behind a pointer: Mosaic moves

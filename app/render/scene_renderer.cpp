@@ -30,8 +30,8 @@ namespace terravol::app::render {
 namespace {
 
 // Runs `work` on this thread at nice `nice` (at_lowest_priority: 19), its TBB loops on this
-// thread alone: the viewer's worker then gets the cores mostly while the frames leave them idle (the
-// main thread's traversal leaves one of llvmpipe's two), instead of taking one from the
+// thread alone: the viewer's worker then gets the cores mostly while the frames leave them idle
+// (the main thread's traversal leaves one of llvmpipe's two), instead of taking one from the
 // rasterizer threads for the length of a slide. The slide arrives a few frames later; the
 // frames during it keep their pace. Nice 19, not SCHED_IDLE: a thread the frames wait for (a
 // scene freed before the next slide swaps) still advances, if slowly, when other processes
@@ -223,7 +223,8 @@ std::optional<scene::WindowChoice> SceneRenderer::next_window(const scene::Camer
 
 // Reads `next` from the mosaic in `frame`. Touches nothing of the pipeline, so it may run on a
 // worker thread while the pipeline draws.
-SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic, const scene::WindowChoice& next,
+SceneRenderer::PreparedSlide SceneRenderer::prepare_slide(const io::Mosaic& mosaic,
+                                                          const scene::WindowChoice& next,
                                                           const io::SceneFrame& frame) {
   PreparedSlide p;
   const auto t0 = Clock::now();
@@ -385,11 +386,13 @@ void SceneRenderer::slide(const scene::CameraPose& pose, FrameStats& stats) {
           // for: a starved thread holding it would stall frames. The read holds no lock a frame
           // waits for (ground_height() beyond the window does not wait for its decode; an
           // earlier read under one lock of the mosaic stalled such frames for 70-235 ms).
-          PreparedSlide p = std::async(std::launch::async, [&] {
-            PreparedSlide read = at_priority(kReadNice, [&] { return prepare_slide(mosaic_, w, frame); });
-            at_lowest_priority([&] { shade_slide(read, shading, terrain_vertices); });
-            return read;
-          }).get();
+          PreparedSlide p =
+              std::async(std::launch::async, [&] {
+                PreparedSlide read =
+                    at_priority(kReadNice, [&] { return prepare_slide(mosaic_, w, frame); });
+                at_lowest_priority([&] { shade_slide(read, shading, terrain_vertices); });
+                return read;
+              }).get();
           slide_copy(p);
           return p;
         });
@@ -527,7 +530,9 @@ const scene::MergeFigures& SceneRenderer::remerge() {
   return volumes_.figures();
 }
 
-bool SceneRenderer::memory_to_return() const { return memory_to_return_ && !pending_.valid(); }
+bool SceneRenderer::memory_to_return() const {
+  return memory_to_return_ && !pending_.valid();
+}
 
 void SceneRenderer::return_memory() {
   if (retired_.valid()) retired_.wait();
@@ -595,13 +600,15 @@ double SceneRenderer::ground_height(double lat, double lon) const {
   if (lat >= b.south && lat <= b.north && lon >= b.west && lon <= b.east) return scene_->ground_height(lat, lon);
   const io::Georef& g = mosaic_.georef();
   if (pending_.valid()) {
-    // A slide is under way: its worker may be decoding the tiles here at the lowest priority.
+    // A slide is under way: its worker may be decoding the tiles here at a low priority.
     // A frame does not wait for that: until they are decoded, the ground of the window's
     // nearest point (beyond the window, the eye sees only its walls and what lies outside).
-    if (const auto near = scene::GroundGrid::cached(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)) {
+    if (const auto near =
+            scene::GroundGrid::cached(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)) {
       return (*near)(lat, lon);
     }
-    return scene_->ground_height(std::clamp(lat, b.south, b.north), std::clamp(lon, b.west, b.east));
+    return scene_->ground_height(std::clamp(lat, b.south, b.north),
+                                 std::clamp(lon, b.west, b.east));
   }
   return scene::GroundGrid(mosaic_, lat - g.dy, lat + g.dy, lon - g.dx, lon + g.dx)(lat, lon);
 }

@@ -8,7 +8,8 @@
 
 namespace terravol::app::scene {
 
-GroundGrid::Span GroundGrid::span(const io::Mosaic& mosaic, double south, double north, double west, double east) {
+GroundGrid::Span GroundGrid::span(const io::Mosaic& mosaic, double south, double north, double west,
+                                  double east) {
   const io::Georef& g = mosaic.georef();
   const int r0 = static_cast<int>(std::floor((g.y0 - north) / g.dy)) - 2;
   const int r1 = static_cast<int>(std::ceil((g.y0 - south) / g.dy)) + 2;
@@ -17,7 +18,8 @@ GroundGrid::Span GroundGrid::span(const io::Mosaic& mosaic, double south, double
   return {r0, c0, std::clamp(r1 - r0 + 1, 2, 20000), std::clamp(c1 - c0 + 1, 2, 20000)};
 }
 
-GroundGrid::GroundGrid(const io::Mosaic& mosaic, const Span& s, io::Grid grid) : grid_(std::move(grid)) {
+GroundGrid::GroundGrid(const io::Mosaic& mosaic, const Span& s, io::Grid grid)
+    : grid_(std::move(grid)) {
   const io::Georef& g = mosaic.georef();
   io::fill_voids(grid_);
   lat0_ = g.y0 - s.r0 * g.dy;
@@ -26,13 +28,14 @@ GroundGrid::GroundGrid(const io::Mosaic& mosaic, const Span& s, io::Grid grid) :
   dlon_ = g.dx;
 }
 
-GroundGrid::GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east) {
+GroundGrid::GroundGrid(const io::Mosaic& mosaic, double south, double north, double west,
+                       double east) {
   const Span s = span(mosaic, south, north, west, east);
   *this = GroundGrid(mosaic, s, mosaic.read_window(s.r0, s.c0, s.rows, s.cols));
 }
 
-std::optional<GroundGrid> GroundGrid::cached(const io::Mosaic& mosaic, double south, double north, double west,
-                                             double east) {
+std::optional<GroundGrid> GroundGrid::cached(const io::Mosaic& mosaic, double south, double north,
+                                             double west, double east) {
   const Span s = span(mosaic, south, north, west, east);
   std::optional<io::Grid> grid = mosaic.read_cached_window(s.r0, s.c0, s.rows, s.cols);
   if (!grid) return std::nullopt;

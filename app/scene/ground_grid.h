@@ -19,8 +19,8 @@ class GroundGrid {
   GroundGrid(const io::Mosaic& mosaic, double south, double north, double west, double east);
   // The same from the mosaic's cached tiles alone (io::Mosaic::read_cached_window): nullopt,
   // and nothing decoded, when a tile it needs is not cached.
-  static std::optional<GroundGrid> cached(const io::Mosaic& mosaic, double south, double north, double west,
-                                          double east);
+  static std::optional<GroundGrid> cached(const io::Mosaic& mosaic, double south, double north,
+                                          double west, double east);
 
   // Metres in the DEM's datum at a geographic point, bilinear; clamped to the rectangle.
   // Precondition: built by the reading constructor.

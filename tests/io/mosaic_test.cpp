@@ -156,7 +156,8 @@ TEST(Mosaic, WindowsReadOnTwoThreadsAtOnceHoldTheSerialReadsSamples) {
   for (int k = 0; k < 24; ++k) windows.push_back({at(rng), at(rng)});
   std::vector<Grid> got(windows.size());
   auto read = [&](std::size_t first) {
-    for (std::size_t k = first; k < windows.size(); k += 2) got[k] = shared.read_window(windows[k].row0, windows[k].col0, 40, 40);
+    for (std::size_t k = first; k < windows.size(); k += 2)
+      got[k] = shared.read_window(windows[k].row0, windows[k].col0, 40, 40);
   };
   std::thread other(read, 1);
   read(0);
