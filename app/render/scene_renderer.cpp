@@ -48,8 +48,8 @@ auto at_priority(int nice, Work&& work) {
 // The slide worker's read of the moved window (decoding new tiles: about 650 ms of CPU for two
 // of Utah's .sdf.bz2) at nice 10, between the frames' 0 and the shading's 19: at 19 it starved
 // while the frames kept both cores busy (the benchmark's flight left the window before a slide
-// landed, and in one run of 1000 frames none landed); at 10 it lands about as soon as at 0
-// (0.7-0.8 s a slide against 0.5-0.8) and takes less from the frames (measured: docs/
+// landed, and in one run of 1000 frames none landed); at 10 every run landed its slides, in
+// 0.7-1.5 s against 0.5-0.8 at 0, and the frames lost less to it (measured: docs/
 // architecture.md, the viewer's slides).
 constexpr int kReadNice = 10;
 
