@@ -99,7 +99,7 @@ CLI::Option* add_density_threshold_option(CLI::App& cmd, double& threshold) {
 CLI::Option* add_density_error_option(CLI::App& cmd, double& levels) {
   return cmd.add_option("--density-error", levels,
                         "Density: a colour cube whose faces stand for its contents within this many 1/255 levels "
-                        "(premultiplied colour and opacity) is also drawn whole while it spans fewer than 8 pixels; "
+                        "(premultiplied colour and opacity) is also drawn whole while it spans fewer than 32 pixels; "
                         "0: off, the projected size alone decides");
 }
 

@@ -70,7 +70,7 @@ TEST(DensityReference, ColourCubesAgreeWithTheRayMarcherFromNearAndFar) {
     if (epsilon == 1.0) {  // the targets at the default epsilon: mean <= 2/255, 99th percentile <= 16/255
       EXPECT_LE(e[0].mean, 2.0) << d << " radii";
       EXPECT_LE(e[0].p99, 16.0) << d << " radii";
-      // With the commands' error tolerance (1/255; cells up to 8 px): the same targets.
+      // With the commands' error tolerance (1/255; cells up to 32 px): the same targets.
       RefineOptions tolerant{epsilon, false, true};
       tolerant.error_tolerance = 1.0 / 255.0;
       std::vector<mrbsp::ColorBox> boxes;
