@@ -1224,8 +1224,9 @@ void build_slot(const TerrainTree::Impl& m, SlotKey key, SlotBuilder& builder) {
 // Builds a slot's small BSP afresh from the pieces every surface sent there, and notes what
 // the build made of them (BspStore::fresh_pieces).
 void build_anew(const TerrainTree::Impl& m, Slot& slot) {
-  slot.store = std::make_unique<BspStore>();
-  SlotBuilder builder(m, *slot.store);
+  auto store = std::make_shared<BspStore>();
+  slot.store = store;
+  SlotBuilder builder(m, *store);
   std::uint32_t arrivals = 0;
   for (const auto& [id, s] : m.surfaces) {
     s.for_each_arrival(slot.key, [&](std::span<const std::uint32_t> piece) {
@@ -1234,8 +1235,8 @@ void build_anew(const TerrainTree::Impl& m, Slot& slot) {
     });
   }
   build_slot(m, slot.key, builder);
-  slot.store->fresh_pieces = slot.store->pieces;
-  slot.store->arrivals = slot.store->fresh_arrivals = arrivals;
+  store->fresh_pieces = store->pieces;
+  store->arrivals = store->fresh_arrivals = arrivals;
 }
 
 template <class T>
@@ -1462,7 +1463,7 @@ void TerrainTree::Impl::compact() {
   std::vector<glm::vec2> kept_tcoords;
   for (Slot& slot : slots) {
     if (!slot.store) continue;
-    for (std::uint32_t& v : slot.store->refs) {
+    for (std::uint32_t& v : slot.own_store().refs) {
       if (v < base) continue;
       std::uint32_t& r = remap[v - base];
       if (r == std::numeric_limits<std::uint32_t>::max()) {
@@ -1633,7 +1634,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     if (is_low(key) && !slot.built) return;  // built when first drawn
     // The changed surfaces' new pieces inserted into the BSP kept.
     const auto insert_changed = [&] {
-      SlotBuilder builder(*this, *slot.store);
+      SlotBuilder builder(*this, slot.own_store());
       for (const auto& [id, s] : surfaces) {
         if (!std::binary_search(changed.begin(), changed.end(), id)) continue;
         s.for_each_arrival(key, [&](std::span<const std::uint32_t> piece) { builder.add(s, id, piece); });
@@ -1642,20 +1643,20 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     };
     bool anew = !slot.built || rebuild;
     if (slot.built) {
-      if (!rebuild) removed[k] = remove_surfaces(*slot.store, changed, positions);
+      if (!rebuild) removed[k] = remove_surfaces(slot.own_store(), changed, positions);
       anew = anew || slot.store->pieces == 0 || slot.store->nodes.size() > 4 * slot.store->pieces + 64;
       if (anew) removed[k] += slot.store->refs.size();
     }
     if (!anew) {
       if (arriving > 0) insert_changed();
       inserted[k] = arriving > 0;
-      slot.store->arrivals = slot.pending;
+      slot.own_store().arrivals = slot.pending;
     }
     if (anew) build_anew(*this, slot);
     slot.built = true;
     slot.pending = 0;
     slot.top = slot.store->top;
-    slot.store->bound_nodes(positions);  // read only here: flushes come after
+    slot.own_store().bound_nodes(positions);  // read only here: flushes come after
   };
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, order.size(), 1),
@@ -1700,7 +1701,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
   std::vector<BspStore*> to_flush;
   for (std::size_t k = 0; k < slots.size(); ++k) {
     if (k + 8 < slots.size() && slots[k + 8].store) __builtin_prefetch(slots[k + 8].store.get());
-    const Slot& slot = slots[k];
+    Slot& slot = slots[k];
     merge_stats.pending_slots += slot.built ? 0 : 1;
     merge_stats.pending_pieces += slot.pending;
     const BspStore* store = slot.store.get();
@@ -1711,7 +1712,7 @@ void TerrainTree::Impl::update(const std::vector<std::uint32_t>& changed_in, std
     staged += store->staged_count();
     live += store->refs.size();
     if (store->staged || store->staged_refs < store->refs.size()) {
-      to_flush.push_back(slot.store.get());
+      to_flush.push_back(&slot.own_store());
     }
   }
   // Room for the staged vertices and, when the vertices must move anyway, a sixteenth of the
@@ -1747,11 +1748,11 @@ void TerrainTree::Impl::build_pending(std::span<const std::int32_t> ks) {
     slot.built = true;
     slot.pending = 0;
     slot.top = slot.store->top;
-    slot.store->bound_nodes(positions);  // read only here: flushes come after
+    slot.own_store().bound_nodes(positions);  // read only here: flushes come after
   });
   for (const std::int32_t k : ks) {
     Slot& slot = slots[static_cast<std::size_t>(k)];
-    flush(*slot.store);
+    flush(slot.own_store());
     merge_stats.stored_polygons += slot.store->pieces;
     merge_stats.dropped_pieces += slot.store->dropped;
     --merge_stats.pending_slots;
@@ -1873,7 +1874,7 @@ void TerrainTree::Impl::shift_merged(int di, int dj) {
       // bench's Utah slide (92,000 slots) 4-5 ms more: 96.5 and 79.4 ms against 91.6 and
       // 75.3 ms, alternating runs.
       const auto moved_by = static_cast<std::uint32_t>(dj * (n + 1) + di);  // modulo 2^32: negative too
-      BspStore& store = *slots[k].store;
+      BspStore& store = slots[k].own_store();
       for (const Polygon& p : store.polys) {
         if (p.surface != kTerrainSurface) continue;
         for (std::uint32_t r = p.first; r < p.first + p.count; ++r) store.refs[r] -= moved_by;

@@ -228,9 +228,11 @@ class TerrainTree {
   // n = 2^k; level levels-1 is the full-resolution grid, each coarser level halves the
   // samples per side). Throws std::invalid_argument for a bad window or level count.
   TerrainTree(const TerrainWindow& window, int levels);
-  // A deep copy: what the copy does afterwards (slide, merge, traverse) leaves `other` as it
-  // is (terravol view slides a copy on a worker thread while frames go on). It must not run
-  // while another thread changes `other`.
+  // An independent copy: what the copy does afterwards (slide, merge, traverse) leaves `other`
+  // as it is, and each may then be used on its own thread (terravol view slides a copy on a
+  // worker thread while frames go on). The small BSPs of merged surfaces are shared until one
+  // of the two changes them (copy on write), so the copy is cheap. It must not run while
+  // another thread changes `other`.
   TerrainTree(const TerrainTree& other);
   ~TerrainTree();
   TerrainTree(TerrainTree&&) noexcept;

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -73,8 +74,8 @@ struct NodeBox {
 inline constexpr std::int32_t kDropSide = -2;
 
 // A std::unique_ptr whose copy copies what it points to, so that the structures holding one
-// copy deeply with their implicit copy (TerrainTree's copy: terravol view slides a copy on a
-// worker thread).
+// copy deeply with their implicit copy (a store's staged vertices; the stores themselves are
+// shared by copies of the tree, Slot::own_store).
 template <class T>
 struct DeepPtr : std::unique_ptr<T> {
   DeepPtr() = default;
@@ -243,10 +244,21 @@ struct Slot {
   std::size_t pending = 0;  // pieces arrived, while not built
   float top = 0.0f;         // highest vertex of the pieces arrived; once built, the store's top
   // Held apart (about 200 bytes of empty containers): most slots are low alternatives that are
-  // never built. Not null when built.
-  DeepPtr<BspStore> store;
+  // never built. Not null when built. A copy of the tree shares its slots' stores instead of
+  // copying them (`terravol view` copies the scene to slide it on a worker thread while frames
+  // wait for the copy); a store is changed only through own_store().
+  std::shared_ptr<const BspStore> store;
   // The store's, or 0 when there is none.
   std::size_t refs() const { return store ? store->refs.size() : 0; }
+  // The store to change (not null): first copied when another tree shares it (copy on write).
+  // Two trees sharing a store may call it at once from their own threads: each then changes
+  // only its own copy, and a store is changed in place only once no other tree holds it.
+  BspStore& own_store() {
+    if (store.use_count() > 1) store = std::make_shared<BspStore>(*store);
+    // The other tree's last reads of the store happened before it let go of it.
+    std::atomic_thread_fence(std::memory_order_acquire);
+    return const_cast<BspStore&>(*store);  // made non-const (make_shared<BspStore>)
+  }
 };
 
 struct TerrainTree::Impl {

@@ -245,7 +245,8 @@ void SceneRenderer::shade_slide(PreparedSlide& p, const scene::ShadingOptions& s
 void SceneRenderer::slide_copy(PreparedSlide& p) const {
   // The copy waits for a frame's preparation to end, so that it is taken while that frame
   // draws: taken whenever the read ended, it came at the next preparation as often as not,
-  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy takes 43-104).
+  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy took 43-137 ms
+  // until the copy shared the small BSPs; 25-52 ms since).
   // Not for long: with no frames coming (the viewer idle) it is taken anyway.
   {
     std::unique_lock<std::mutex> wait(prepared_mutex_);
@@ -277,7 +278,7 @@ void SceneRenderer::finish_slide(PreparedSlide&& p) {
   const auto t0 = Clock::now();
   if (p.slid && p.edits == edits_) {
     // The tree slid on the worker, on a copy of the scene taken after the last edit: the same
-    // tree this thread's slide would make (TerrainTree's copy is deep). Swapped in; the old
+    // tree this thread's slide would make (TerrainTree's copy is independent). Swapped in; the old
     // scene is freed on a worker (its small BSPs are tens of thousands of allocations).
     std::swap(scene_, p.slid);
     if (retired_.valid()) retired_.wait();

@@ -1,10 +1,13 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "mrbsp/terrain_tree.h"
 #include "tree_test_util.h"
@@ -370,7 +373,7 @@ TEST(Merge, ASlideByWholeCellsKeepsWhatStaysAndDrawsWhatAFreshMergeDraws) {
   }
 }
 
-// A copy is deep (terravol view slides a copy on a worker while frames go on): the copy slid
+// A copy is independent (terravol view slides a copy on a worker while frames go on): the copy slid
 // and traversed (building low alternatives on first use) holds and draws what the original
 // slid the same way does, and the original, left alone meanwhile, draws what it drew before.
 TEST(Merge, ACopySlidAndTraversedLeavesTheOriginalAsItWas) {
@@ -408,6 +411,81 @@ TEST(Merge, ACopySlidAndTraversedLeavesTheOriginalAsItWas) {
   EXPECT_EQ(original.merged_colors(), colors);
   original.traverse(c, o, f);
   EXPECT_EQ(f.indices, before.indices);
+  EXPECT_EQ(order_violations(original, f, c.eye, 150, rng, true), 0);
+}
+
+// A copy shares the original's small BSPs until one of the two changes them (copy on write):
+// the copy slid and traversed on another thread while the original is edited, traversed and
+// tidied on this one, each ends holding and drawing what the same steps make of a tree alone.
+TEST(Merge, ACopySlidOnAnotherThreadWhileTheOriginalIsEditedEndsAsIfEachWereAlone) {
+  std::mt19937 rng(2027);
+  const test::SlidingTerrain terrain(5);
+  const Soup a = soup_over_sliding_terrain(rng, 50), b = soup_over_sliding_terrain(rng, 30),
+             b2 = soup_over_sliding_terrain(rng, 30);
+  const auto input = [](const Soup& s) { return SurfaceInput{s.v, s.c, s.t}; };
+  const std::uint32_t ids[2] = {1, 2};
+  const SurfaceInput both[2] = {input(a), input(b)};
+  const Camera c = camera_at({800.0, -200.0, 900.0}, {0.1, 1.0, -0.6});
+  TraversalOptions o;
+  o.threshold_px = 3.0f;
+  // The common start: merged, then a frame (which builds the low slots it draws).
+  const auto start = [&] {
+    TerrainTree t(terrain.window_at(0, 0).view(), 3);
+    t.set_surfaces(ids, both);
+    Frame f;
+    t.traverse(c, o, f);
+    return t;
+  };
+  struct Result {
+    std::vector<std::uint32_t> indices;
+    std::vector<glm::vec3> positions;
+    std::vector<glm::u8vec4> colors;
+  };
+  const auto slide_steps = [&](TerrainTree& t) {
+    Result r;
+    for (const auto& at : {std::array{8, 4}, std::array{4, 12}, std::array{0, 0}}) {
+      t.slide(terrain.window_at(at[0], at[1]).view());
+      Frame f;
+      t.traverse(camera_at({100.0 * at[0] + 800.0, 100.0 * at[1] - 200.0, 900.0}, {0.1, 1.0, -0.6}), o, f);
+      r.indices.insert(r.indices.end(), f.indices.begin(), f.indices.end());
+    }
+    r.positions = t.positions();
+    r.colors = t.merged_colors();
+    return r;
+  };
+  const auto edit_steps = [&](TerrainTree& t) {
+    Result r;
+    for (int k = 0; k < 4; ++k) {
+      t.set_surface(2, input(k % 2 ? b : b2));
+      Frame f;
+      t.traverse(camera_at({300.0 + 200.0 * k, -300.0, 700.0}, {0.2, 1.0, -0.5}), o, f);
+      r.indices.insert(r.indices.end(), f.indices.begin(), f.indices.end());
+      if (k == 2) t.tidy();
+    }
+    r.positions = t.positions();
+    r.colors = t.merged_colors();
+    return r;
+  };
+  TerrainTree alone_slid = start(), alone_edited = start();
+  const Result slid_reference = slide_steps(alone_slid), edited_reference = edit_steps(alone_edited);
+
+  TerrainTree original = start();
+  TerrainTree copy(original);
+  Result slid;
+  std::thread worker([&] { slid = slide_steps(copy); });
+  const Result edited = edit_steps(original);
+  worker.join();
+  EXPECT_EQ(slid.indices, slid_reference.indices);
+  EXPECT_EQ(slid.positions, slid_reference.positions);
+  EXPECT_EQ(slid.colors, slid_reference.colors);
+  EXPECT_EQ(edited.indices, edited_reference.indices);
+  EXPECT_EQ(edited.positions, edited_reference.positions);
+  EXPECT_EQ(edited.colors, edited_reference.colors);
+  Frame f;
+  copy.traverse(c, o, f);
+  EXPECT_GT(drawn_merged_area(copy, f), 0.0);
+  EXPECT_EQ(order_violations(copy, f, c.eye, 150, rng, true), 0);
+  original.traverse(c, o, f);
   EXPECT_EQ(order_violations(original, f, c.eye, 150, rng, true), 0);
 }
 
