@@ -446,7 +446,8 @@ TEST(Merge, ACopySlidOnAnotherThreadWhileTheOriginalIsEditedEndsAsIfEachWereAlon
     for (const auto& at : {std::array{8, 4}, std::array{4, 12}, std::array{0, 0}}) {
       t.slide(terrain.window_at(at[0], at[1]).view());
       Frame f;
-      t.traverse(camera_at({100.0 * at[0] + 800.0, 100.0 * at[1] - 200.0, 900.0}, {0.1, 1.0, -0.6}), o, f);
+      t.traverse(camera_at({100.0 * at[0] + 800.0, 100.0 * at[1] - 200.0, 900.0}, {0.1, 1.0, -0.6}),
+                 o, f);
       r.indices.insert(r.indices.end(), f.indices.begin(), f.indices.end());
     }
     r.positions = t.positions();
@@ -467,7 +468,8 @@ TEST(Merge, ACopySlidOnAnotherThreadWhileTheOriginalIsEditedEndsAsIfEachWereAlon
     return r;
   };
   TerrainTree alone_slid = start(), alone_edited = start();
-  const Result slid_reference = slide_steps(alone_slid), edited_reference = edit_steps(alone_edited);
+  const Result slid_reference = slide_steps(alone_slid),
+               edited_reference = edit_steps(alone_edited);
 
   TerrainTree original = start();
   TerrainTree copy(original);
