@@ -250,7 +250,8 @@ struct Slot {
   std::shared_ptr<const BspStore> store;
   // The store's, or 0 when there is none.
   std::size_t refs() const { return store ? store->refs.size() : 0; }
-  // The store to change (not null): first copied when another tree shares it (copy on write).
+  // The store to change, of a slot that has one: first copied when another tree shares it (copy
+  // on write).
   // Two trees sharing a store may call it at once from their own threads: each then changes
   // only its own copy, and a store is changed in place only once no other tree holds it.
   BspStore& own_store() {

@@ -44,7 +44,8 @@ inline constexpr double kDefaultDensityThreshold = 1.0;
 inline constexpr double kMinDensityThreshold = 0.25, kMaxDensityThreshold = 64.0;
 // Densities: a colour cube whose faces stand for its contents within this many 1/255 levels
 // (premultiplied; density::RefineOptions::error_tolerance) is also drawn whole while it spans
-// fewer than 32 pixels (density::RefineOptions::max_size_px); 0 turns that off (Chamberlain's projected size alone).
+// fewer than 32 pixels (density::RefineOptions::max_size_px); 0 turns that off (Chamberlain's
+// projected size alone).
 inline constexpr double kDefaultDensityError = 1.0;
 inline constexpr double kMaxDensityError = 64.0;
 

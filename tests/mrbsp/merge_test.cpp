@@ -477,12 +477,13 @@ TEST(Merge, ACopySlidOnAnotherThreadWhileTheOriginalIsEditedEndsAsIfEachWereAlon
   std::thread worker([&] { slid = slide_steps(copy); });
   const Result edited = edit_steps(original);
   worker.join();
-  EXPECT_EQ(slid.indices, slid_reference.indices);
-  EXPECT_EQ(slid.positions, slid_reference.positions);
-  EXPECT_EQ(slid.colors, slid_reference.colors);
-  EXPECT_EQ(edited.indices, edited_reference.indices);
-  EXPECT_EQ(edited.positions, edited_reference.positions);
-  EXPECT_EQ(edited.colors, edited_reference.colors);
+  const auto expect_same = [](const Result& got, const Result& alone, const char* which) {
+    EXPECT_EQ(got.indices, alone.indices) << which;
+    EXPECT_EQ(got.positions, alone.positions) << which;
+    EXPECT_EQ(got.colors, alone.colors) << which;
+  };
+  expect_same(slid, slid_reference, "the copy, slid");
+  expect_same(edited, edited_reference, "the original, edited");
   Frame f;
   copy.traverse(c, o, f);
   EXPECT_GT(drawn_merged_area(copy, f), 0.0);
