@@ -245,8 +245,8 @@ void SceneRenderer::shade_slide(PreparedSlide& p, const scene::ShadingOptions& s
 void SceneRenderer::slide_copy(PreparedSlide& p) const {
   // The copy waits for a frame's preparation to end, so that it is taken while that frame
   // draws: taken whenever the read ended, it came at the next preparation as often as not,
-  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy took 43-137 ms
-  // until the copy shared the small BSPs; 25-52 ms since).
+  // which then waited for it (29-62 ms with the benchmark's volumes, whose copy took 43-140 ms
+  // until the copy shared the small BSPs; 25-61 ms since).
   // Not for long: with no frames coming (the viewer idle) it is taken anyway.
   {
     std::unique_lock<std::mutex> wait(prepared_mutex_);
