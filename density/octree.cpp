@@ -287,6 +287,19 @@ std::size_t ColorCubeOctree::cell_index(int level, int i, int j, int k) const {
          static_cast<std::size_t>(i);
 }
 
+int ColorCubeOctree::parallel_level() const {
+  int level = levels() - 1;
+  while (level > 1) {
+    const auto& d = dims_[static_cast<std::size_t>(level)];
+    if (static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) *
+            static_cast<std::size_t>(d[2]) >=
+        64)
+      break;
+    --level;
+  }
+  return level;
+}
+
 bool ColorCubeOctree::maybe_filled(int level, int i, int j, int k) const {
   const auto& d = dims_[static_cast<std::size_t>(level)];
   const auto& r = filled_[static_cast<std::size_t>(level)][static_cast<std::size_t>(j * d[0] + i)];
@@ -407,13 +420,8 @@ void ColorCubeOctree::build_all() {
     errors_[lv].assign(cells, 0);
   }
   const int top = levels() - 1;
-  // The level whose subtrees are built in parallel: the highest with at least 64 cells.
-  int split = top;
-  while (split > 1) {
-    const auto& d = dims_[static_cast<std::size_t>(split)];
-    if (static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]) >= 64) break;
-    --split;
-  }
+  // The level whose subtrees are built in parallel.
+  const int split = parallel_level();
   std::vector<std::vector<Faces>> above(dims_.size());  // float faces of the levels split and up
   {
     const auto& d = dims_[static_cast<std::size_t>(split)];
@@ -595,16 +603,10 @@ void ColorCubeOctree::refine(const mrbsp::Camera& camera, const RefineOptions& o
       }
     }
   };
-  // The walk down to the level with at least 64 cells (as the build's), then its subtrees in
-  // parallel (TBB), each into its own boxes, put in place after: the same boxes in the same
-  // order as one walk. The default view over the bundled DEM refines 588k cells.
-  int split = top;
-  while (split > 1 && static_cast<std::size_t>(dims_[static_cast<std::size_t>(split)][0]) *
-                              static_cast<std::size_t>(dims_[static_cast<std::size_t>(split)][1]) *
-                              static_cast<std::size_t>(dims_[static_cast<std::size_t>(split)][2]) <
-                          64) {
-    --split;
-  }
+  // The walk down to the parallel level, then its subtrees in parallel (TBB), each into its own
+  // boxes, put in place after: the same boxes in the same order as one walk. The default view
+  // over the bundled DEM refines 588k cells.
+  const int split = parallel_level();
   std::vector<mrbsp::ColorBox> above;
   std::vector<Task> tasks;
   walk({top, 0, 0, 0, 31}, above, stats, split < top ? split : -1, &tasks);

@@ -139,6 +139,9 @@ class ColorCubeOctree {
   // Stores a cell's faces (packed) and its error: `deviation` plus its children's.
   void keep(int level, int i, int j, int k, const Faces& f, float deviation);
   bool maybe_filled(int level, int i, int j, int k) const;
+  // The coarsest level with at least 64 cells (at least 1): the build and the refinement
+  // work on its subtrees in parallel.
+  int parallel_level() const;
   std::size_t cell_index(int level, int i, int j, int k) const;
   void build_all();
 
